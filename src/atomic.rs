@@ -1,0 +1,37 @@
+//! Atomic file output: write beside the target, then rename over it.
+//!
+//! A crash, a full disk or a bad path must never leave a partial CSV, SVG or mesh where a user
+//! (or the next pipeline stage) would read it as complete. The temporary file lives in the
+//! target's directory so the final rename cannot cross file systems, and is removed on failure.
+
+use std::io::Write;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// Writes what `fill` produces to `path` atomically. Errors name `path`.
+pub fn write_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if path.is_dir() {
+        return Err(Error::output(path, "is a directory"));
+    }
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".triorder-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| Error::output(path, e))?;
+    {
+        let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
+        fill(&mut buffered).and_then(|()| buffered.flush()).map_err(|e| Error::output(path, e))?;
+    }
+    tmp.persist(path).map_err(|e| Error::output(path, e.error))?;
+    Ok(())
+}
+
+/// Writes `bytes` to `path` atomically.
+pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_with(path, |w| w.write_all(bytes))
+}

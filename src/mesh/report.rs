@@ -1,0 +1,92 @@
+//! What is unusual about a mesh, counted and reported, never silently repaired.
+//!
+//! Degenerate triangles (a repeated index, or zero area), duplicates, non-manifold and
+//! inconsistently wound edges all change what orderings and metrics do, so `triorder` prints
+//! these counts when it loads a mesh and keeps every triangle as given.
+
+use std::collections::HashSet;
+use std::fmt;
+
+use crate::mesh::Mesh;
+use crate::topology::Topology;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MeshReport {
+    pub triangles: usize,
+    pub vertices: usize,
+    /// Vertices no triangle references.
+    pub unused_vertices: usize,
+    /// Triangles repeating a vertex index.
+    pub repeated_index: usize,
+    /// Triangles with three distinct indices but zero area (collinear or coincident positions).
+    pub zero_area: usize,
+    /// Extra copies of a triangle over the same three welded vertices (any order or winding).
+    pub duplicates: usize,
+    pub boundary_edges: usize,
+    pub non_manifold_edges: usize,
+    /// Edges whose two triangles traverse them in the same direction (inconsistent winding).
+    pub inconsistent_edges: usize,
+    pub components: usize,
+}
+
+impl MeshReport {
+    pub fn new(mesh: &Mesh, topology: &Topology) -> MeshReport {
+        let mut used = vec![false; mesh.vertex_count()];
+        let mut seen = HashSet::with_capacity(mesh.triangle_count());
+        let (mut repeated_index, mut zero_area, mut duplicates) = (0, 0, 0);
+        for tri in &mesh.triangles {
+            tri.iter().for_each(|&v| used[v as usize] = true);
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+                repeated_index += 1;
+            } else {
+                let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+                zero_area += usize::from((b - a).cross(c - a) == glam::Vec3::ZERO);
+            }
+            let mut key = tri.map(|v| topology.weld[v as usize]);
+            key.sort_unstable();
+            duplicates += usize::from(!seen.insert(key));
+        }
+        MeshReport {
+            triangles: mesh.triangle_count(),
+            vertices: mesh.vertex_count(),
+            unused_vertices: used.iter().filter(|&&u| !u).count(),
+            repeated_index,
+            zero_area,
+            duplicates,
+            boundary_edges: topology.boundary_edges,
+            non_manifold_edges: topology.non_manifold_edges,
+            inconsistent_edges: topology.inconsistent_edges,
+            components: topology.component_count,
+        }
+    }
+
+    /// One line per irregularity worth a user's attention (empty for a clean mesh).
+    pub fn warnings(&self) -> Vec<String> {
+        [
+            (self.repeated_index, "degenerate triangles (repeated vertex index)"),
+            (self.zero_area, "degenerate triangles (zero area)"),
+            (self.duplicates, "duplicate triangles"),
+            (self.non_manifold_edges, "non-manifold edges (3+ triangles)"),
+            (self.inconsistent_edges, "edges with inconsistent winding"),
+            (self.unused_vertices, "unused vertices"),
+        ]
+        .into_iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}; kept as given"))
+        .collect()
+    }
+}
+
+impl fmt::Display for MeshReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} triangles, {} vertices, {} components, {} boundary edges",
+            self.triangles, self.vertices, self.components, self.boundary_edges
+        )?;
+        for w in self.warnings() {
+            write!(f, "\n  note: {w}")?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,322 @@
+//! Post-transform vertex-cache simulators: FIFO, LRU and meshoptimizer's batch model.
+//!
+//! ACMR = misses / triangles (Hoppe 1999; Bogomjakov & Gotsman 2002 §1: between 0.5 and 3).
+//! ATVR = misses / distinct vertices referenced (1 is optimal), the denominator meshoptimizer
+//! uses; DirectXMesh divides by all vertices instead, which differs only when some are unused.
+//!
+//! Each simulator is one O(n) pass over the index stream with O(1) work per index, for any
+//! cache size: FIFO keeps per-vertex timestamps (a vertex is cached iff it entered among the last
+//! k misses), LRU keeps an intrusive doubly linked list over vertex ids, and the batch model is
+//! FIFO plus the flush rules of meshoptimizer's `analyzeVertexCache` (ALGORITHMS.md §9).
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+
+/// A vertex-cache model, written `fifo:16`, `lru:32` or `batch:CACHE,WARP,PRIMGROUP`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CacheModel {
+    /// First in, first out: a miss pushes the vertex and evicts the oldest; a hit changes nothing.
+    Fifo(u32),
+    /// Least recently used: a hit also moves the vertex to the front.
+    Lru(u32),
+    /// meshoptimizer's model of a GPU: a FIFO of `cache` entries, flushed (a new batch starts)
+    /// before a triangle whose missing vertices would overflow `warp` vertices or when the batch
+    /// already holds `primgroup` triangles; 0 turns a limit off.
+    Batch { cache: u32, warp: u32, primgroup: u32 },
+}
+
+/// Largest cache we simulate: timestamps are u32 and must not wrap within a mesh.
+const MAX_CACHE: u32 = 1 << 24;
+
+impl CacheModel {
+    /// The cache capacity in vertices.
+    pub fn size(&self) -> u32 {
+        match *self {
+            CacheModel::Fifo(k) | CacheModel::Lru(k) => k,
+            CacheModel::Batch { cache, .. } => cache,
+        }
+    }
+
+    /// The model's family name: `fifo`, `lru` or `batch`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            CacheModel::Fifo(_) => "fifo",
+            CacheModel::Lru(_) => "lru",
+            CacheModel::Batch { .. } => "batch",
+        }
+    }
+}
+
+impl fmt::Display for CacheModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CacheModel::Fifo(k) => write!(f, "fifo:{k}"),
+            CacheModel::Lru(k) => write!(f, "lru:{k}"),
+            CacheModel::Batch { cache, warp, primgroup } => write!(f, "batch:{cache},{warp},{primgroup}"),
+        }
+    }
+}
+
+impl FromStr for CacheModel {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<CacheModel> {
+        let bad = |why: &str| {
+            Error::usage(format!(
+                "cache model `{text}` {why} (expected fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP, e.g. fifo:16, batch:32,32,32)"
+            ))
+        };
+        let (kind, args) = text.split_once(':').ok_or_else(|| bad("has no size"))?;
+        let numbers: Vec<u32> = args
+            .split(',')
+            .map(|a| a.trim().parse::<u32>())
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|_| bad("has a size that is not a non-negative integer"))?;
+        let model = match (kind, numbers.as_slice()) {
+            ("fifo", &[k]) => CacheModel::Fifo(k),
+            ("lru", &[k]) => CacheModel::Lru(k),
+            ("batch", &[cache, warp, primgroup]) => {
+                if warp != 0 && warp < 3 {
+                    return Err(bad("has a warp below 3 (a triangle must fit)"));
+                }
+                CacheModel::Batch { cache, warp, primgroup }
+            }
+            ("fifo" | "lru" | "batch", _) => return Err(bad("has the wrong number of sizes")),
+            _ => return Err(bad("is of an unknown kind")),
+        };
+        if !(1..=MAX_CACHE).contains(&model.size()) {
+            return Err(bad(&format!("has a size outside 1..={MAX_CACHE}")));
+        }
+        Ok(model)
+    }
+}
+
+/// What one simulation counted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CacheStats {
+    pub triangles: usize,
+    /// Distinct vertices the index stream references.
+    pub vertices: usize,
+    /// Vertices transformed (cache misses).
+    pub misses: u64,
+    /// Batches (warps) executed; only the batch model counts them, 0 otherwise.
+    pub batches: u64,
+}
+
+impl CacheStats {
+    /// Average cache miss ratio: misses per triangle.
+    pub fn acmr(&self) -> f64 {
+        self.misses as f64 / self.triangles.max(1) as f64
+    }
+
+    /// Average transform to vertex ratio: misses per distinct referenced vertex.
+    pub fn atvr(&self) -> f64 {
+        self.misses as f64 / self.vertices.max(1) as f64
+    }
+}
+
+/// Simulates `model` over `triangles` (already in draw order) whose indices are < `vertex_count`.
+pub fn simulate(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+    match model {
+        CacheModel::Fifo(k) => fifo(k, triangles, vertex_count),
+        CacheModel::Lru(k) => lru(k, triangles, vertex_count),
+        CacheModel::Batch { cache, warp, primgroup } => batch(cache, warp, primgroup, triangles, vertex_count),
+    }
+}
+
+/// FIFO by timestamps: `stamp[v]` is the miss count when v last entered; v is cached iff fewer
+/// than k misses happened since. Stamps start at k+1 so an untouched vertex (stamp 0) misses, and
+/// a non-zero stamp marks a referenced vertex.
+fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+    let mut stamp = vec![0u32; vertex_count];
+    let mut now = k + 1;
+    for tri in triangles {
+        for &v in tri {
+            let s = &mut stamp[v as usize];
+            if now - *s > k {
+                *s = now;
+                now += 1;
+            }
+        }
+    }
+    CacheStats {
+        triangles: triangles.len(),
+        vertices: stamp.iter().filter(|&&s| s != 0).count(),
+        misses: u64::from(now - (k + 1)),
+        batches: 0,
+    }
+}
+
+/// The batch model, defined as meshoptimizer's `analyzeVertexCache` defines it: before each
+/// triangle, its corners are tested against the cache; if the batch already holds `primgroup`
+/// triangles, or its vertices plus those missing corners would exceed `warp`, the batch is
+/// submitted and the cache emptied. A repeated corner counts once per corner in that test, as
+/// there.
+fn batch(k: u32, warp: u32, primgroup: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+    let mut stamp = vec![0u32; vertex_count];
+    let mut now = k + 1;
+    let (mut misses, mut batches) = (0u64, 0u64);
+    let (mut in_warp, mut in_group) = (0u32, 0u32);
+    for tri in triangles {
+        let missing: u32 = tri.iter().map(|&v| u32::from(now - stamp[v as usize] > k)).sum();
+        if (primgroup != 0 && in_group == primgroup) || (warp != 0 && in_warp + missing > warp) {
+            batches += u64::from(in_warp > 0);
+            in_warp = 0;
+            in_group = 0;
+            now += k + 1;
+        }
+        for &v in tri {
+            let s = &mut stamp[v as usize];
+            if now - *s > k {
+                *s = now;
+                now += 1;
+                misses += 1;
+                in_warp += 1;
+            }
+        }
+        in_group += 1;
+    }
+    batches += u64::from(in_warp > 0);
+    CacheStats { triangles: triangles.len(), vertices: stamp.iter().filter(|&&s| s != 0).count(), misses, batches }
+}
+
+/// LRU as an intrusive doubly linked list over vertex ids (front = most recent), so a hit's
+/// move-to-front and a miss's eviction are O(1) whatever the cache size.
+fn lru(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+    const NIL: u32 = u32::MAX;
+    let mut prev = vec![NIL; vertex_count];
+    let mut next = vec![NIL; vertex_count];
+    let mut cached = vec![false; vertex_count];
+    let mut referenced = vec![false; vertex_count];
+    let (mut head, mut tail, mut len) = (NIL, NIL, 0u32);
+    let mut misses = 0u64;
+    for tri in triangles {
+        for &v in tri {
+            let vi = v as usize;
+            if cached[vi] {
+                if head == v {
+                    continue;
+                }
+                // Unlink v (it has a predecessor since it is not the head).
+                let (p, n) = (prev[vi], next[vi]);
+                next[p as usize] = n;
+                if n == NIL {
+                    tail = p;
+                } else {
+                    prev[n as usize] = p;
+                }
+            } else {
+                misses += 1;
+                referenced[vi] = true;
+                cached[vi] = true;
+                len += 1;
+                if len > k {
+                    let old = tail;
+                    tail = prev[old as usize];
+                    cached[old as usize] = false;
+                    len -= 1;
+                    if tail == NIL {
+                        head = NIL;
+                    } else {
+                        next[tail as usize] = NIL;
+                    }
+                }
+            }
+            // Push v at the front.
+            prev[vi] = NIL;
+            next[vi] = head;
+            if head != NIL {
+                prev[head as usize] = v;
+            }
+            head = v;
+            if tail == NIL {
+                tail = v;
+            }
+        }
+    }
+    CacheStats { triangles: triangles.len(), vertices: referenced.iter().filter(|&&r| r).count(), misses, batches: 0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bogomjakov & Gotsman 2002, Fig. 1: 14 vertices, 16 triangles (1-based in the paper).
+    const FIG1: [[u32; 3]; 16] = [
+        [1, 2, 4],
+        [1, 4, 5],
+        [4, 5, 14],
+        [2, 3, 4],
+        [3, 4, 12],
+        [3, 11, 12],
+        [9, 11, 12],
+        [9, 10, 11],
+        [7, 9, 13],
+        [7, 8, 9],
+        [6, 7, 13],
+        [6, 13, 14],
+        [9, 12, 13],
+        [4, 12, 14],
+        [12, 13, 14],
+        [5, 6, 14],
+    ];
+
+    fn misses(model: &str, tris: &[[u32; 3]], n: usize) -> u64 {
+        simulate(model.parse().unwrap(), tris, n).misses
+    }
+
+    #[test]
+    fn bogomjakov_gotsman_figure_1() {
+        let tris: Vec<_> = FIG1.iter().map(|t| t.map(|v| v - 1)).collect();
+        assert_eq!(misses("fifo:4", &tris, 14), 25);
+        assert_eq!(misses("fifo:16", &tris, 14), 14);
+        let s = simulate(CacheModel::Fifo(4), &tris, 14);
+        assert!((s.acmr() - 1.5625).abs() < 1e-12 && s.vertices == 14);
+        // LRU by hand: the one extra hit is vertex 4 at triangle 4, refreshed by triangle 3.
+        assert_eq!(misses("lru:4", &tris, 14), 24);
+        assert_eq!(misses("lru:16", &tris, 14), 14);
+    }
+
+    #[test]
+    fn fifo_and_lru_differ_on_refresh() {
+        // Cache 2: a b | a c | a d. FIFO evicts a at "c" although it was just used; LRU keeps it.
+        let tris = [[0, 1, 0], [0, 2, 0], [0, 3, 0]];
+        assert_eq!(misses("fifo:2", &tris, 4), 5);
+        assert_eq!(misses("lru:2", &tris, 4), 4);
+    }
+
+    #[test]
+    fn tiny_caches_and_huge_caches() {
+        let tris: Vec<_> = FIG1.iter().map(|t| t.map(|v| v - 1)).collect();
+        // Cache 1: a vertex hits only when it repeats the previous index; never here.
+        assert_eq!(misses("fifo:1", &tris, 14), 48);
+        assert_eq!(misses("lru:1", &tris, 14), 48);
+        assert_eq!(misses("fifo:1000000", &tris, 14), 14);
+    }
+
+    #[test]
+    fn batch_flushes_on_primgroup_and_warp() {
+        let tris = [[0, 1, 2], [0, 1, 2], [0, 1, 2]];
+        // primgroup 2: third triangle starts a new batch with an empty cache.
+        let s = simulate("batch:16,0,2".parse().unwrap(), &tris, 3);
+        assert_eq!((s.misses, s.batches), (6, 2));
+        // warp 3: second triangle adds no vertices, so it fits.
+        let s = simulate("batch:16,3,0".parse().unwrap(), &tris, 3);
+        assert_eq!((s.misses, s.batches), (3, 1));
+        let s = simulate("batch:16,4,0".parse().unwrap(), &[[0, 1, 2], [3, 4, 5]], 6);
+        assert_eq!((s.misses, s.batches), (6, 2));
+    }
+
+    #[test]
+    fn parse_and_display_round_trip() {
+        for text in ["fifo:16", "lru:32", "batch:32,32,32", "batch:16,0,0"] {
+            assert_eq!(text.parse::<CacheModel>().unwrap().to_string(), text);
+        }
+        for bad in ["fifo", "fifo:0", "fifo:x", "lru:1,2", "batch:32,2,0", "mru:4", "fifo:-3", "fifo:99999999"] {
+            let err = bad.parse::<CacheModel>().unwrap_err().to_string();
+            assert!(err.contains(bad), "{err}");
+        }
+    }
+}

@@ -1,0 +1,26 @@
+//! `input`: the triangles in the order the file stores them — the baseline every paper reports
+//! (Bogomjakov & Gotsman 2002, Table 2 "original"; Nehab et al. 2006 compare against it too).
+
+use super::{Method, Order, OrderInput, Ordering, Params};
+use crate::error::Result;
+
+pub static METHOD: Method = Method {
+    name: "input",
+    summary: "the file's own triangle order (baseline)",
+    source: "baseline in every paper",
+    peer: false,
+    params: &[],
+    build,
+};
+
+fn build(_: &Params) -> Box<dyn Ordering> {
+    Box::new(Input)
+}
+
+struct Input;
+
+impl Ordering for Input {
+    fn order(&self, input: &OrderInput) -> Result<Order> {
+        Ok((0..input.mesh.triangle_count() as u32).collect())
+    }
+}

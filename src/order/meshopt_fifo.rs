@@ -1,0 +1,37 @@
+//! `meshopt-fifo` (peer): meshoptimizer's `optimizeVertexCacheFifo`, its implementation of
+//! Tipsify (Sander, Nehab & Barczak 2007, "Fast triangle reordering for vertex locality and
+//! reduced overdraw", §3), run through the `meshopt` crate for a given FIFO size.
+
+use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use crate::error::Result;
+use crate::peer;
+
+pub static METHOD: Method = Method {
+    name: "meshopt-fifo",
+    summary: "meshoptimizer optimizeVertexCacheFifo (Tipsify) [peer]",
+    source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §3",
+    peer: true,
+    params: &[ParamInfo {
+        name: "cache",
+        default: "16",
+        kind: ParamKind::Int { min: 3, max: 1 << 16 },
+        help: "FIFO size the order is tuned for",
+    }],
+    build,
+};
+
+fn build(params: &Params) -> Box<dyn Ordering> {
+    Box::new(MeshoptFifo { cache: params.int("cache") as u32 })
+}
+
+struct MeshoptFifo {
+    cache: u32,
+}
+
+impl Ordering for MeshoptFifo {
+    fn order(&self, input: &OrderInput) -> Result<Order> {
+        let mesh = input.mesh;
+        let indices = meshopt::optimize_vertex_cache_fifo(&peer::index_buffer(mesh), mesh.vertex_count(), self.cache);
+        peer::order_from_index_buffer(mesh, &indices)
+    }
+}

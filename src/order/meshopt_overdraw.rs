@@ -1,0 +1,39 @@
+//! `meshopt-overdraw` (peer): meshoptimizer's `optimizeOverdraw` on top of `optimizeVertexCache`,
+//! its take on Sander, Nehab & Barczak 2007 §4-5 (linear clustering at cache-flush boundaries,
+//! then clusters sorted by the dot rule). Its threshold differs from the paper's λ: a cluster is
+//! cut once its local ACMR is within `threshold` × the global ACMR.
+
+use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use crate::error::Result;
+use crate::peer;
+
+pub static METHOD: Method = Method {
+    name: "meshopt-overdraw",
+    summary: "meshoptimizer optimizeVertexCache + optimizeOverdraw (Sander 2007 clustering) [peer]",
+    source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §4-5",
+    peer: true,
+    params: &[ParamInfo {
+        name: "threshold",
+        default: "1.05",
+        kind: ParamKind::Float { min: 1.0, max: 3.0 },
+        help: "allowed ACMR degradation (1.05 = 5%) in exchange for less overdraw",
+    }],
+    build,
+};
+
+fn build(params: &Params) -> Box<dyn Ordering> {
+    Box::new(MeshoptOverdraw { threshold: params.float("threshold") as f32 })
+}
+
+struct MeshoptOverdraw {
+    threshold: f32,
+}
+
+impl Ordering for MeshoptOverdraw {
+    fn order(&self, input: &OrderInput) -> Result<Order> {
+        let mesh = input.mesh;
+        let mut indices = meshopt::optimize_vertex_cache(&peer::index_buffer(mesh), mesh.vertex_count());
+        meshopt::optimize_overdraw_in_place(&mut indices, &peer::positions(mesh), self.threshold);
+        peer::order_from_index_buffer(mesh, &indices)
+    }
+}

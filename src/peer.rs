@@ -1,0 +1,50 @@
+//! Glue to the `meshopt` crate (meshoptimizer), our peer and cross-check.
+//!
+//! meshoptimizer speaks flat index buffers and raw position bytes; triorder speaks triangle ids.
+//! These helpers convert between the two, checking that what comes back is a permutation of the
+//! input's triangles rather than trusting it.
+
+use std::collections::HashMap;
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::order::Order;
+
+/// Positions as meshoptimizer reads them: tightly packed `[f32; 3]`.
+pub fn positions(mesh: &Mesh) -> meshopt::VertexDataAdapter<'_> {
+    let bytes = meshopt::typed_to_bytes(&mesh.positions);
+    meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<glam::Vec3>(), 0)
+        .expect("Vec3 slices are a whole number of 12-byte vertices")
+}
+
+/// Recovers triangle ids from an index buffer that a library (meshoptimizer) produced by permuting
+/// the input's triangles. A triangle may come back rotated (same winding); it must not come back
+/// reversed or altered. Duplicate triangles are matched in input order.
+pub fn order_from_index_buffer(mesh: &Mesh, indices: &[u32]) -> Result<Order> {
+    let rotation = |t: [u32; 3]| {
+        let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+        [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+    };
+    let mut ids: HashMap<[u32; 3], Vec<u32>> = HashMap::with_capacity(mesh.triangle_count());
+    for (t, &tri) in mesh.triangles.iter().enumerate().rev() {
+        ids.entry(rotation(tri)).or_default().push(t as u32);
+    }
+    let wrong = |what: String| Error::usage(format!("internal error: peer library returned {what}"));
+    if indices.len() != 3 * mesh.triangle_count() {
+        return Err(wrong(format!("{} indices for {} triangles", indices.len(), mesh.triangle_count())));
+    }
+    indices
+        .chunks_exact(3)
+        .map(|c| {
+            let tri = [c[0], c[1], c[2]];
+            ids.get_mut(&rotation(tri))
+                .and_then(Vec::pop)
+                .ok_or_else(|| wrong(format!("triangle {tri:?}, which is not one of the input's")))
+        })
+        .collect()
+}
+
+/// The mesh's triangles as a flat index buffer, as libraries and GPUs take them.
+pub fn index_buffer(mesh: &Mesh) -> Vec<u32> {
+    mesh.triangles.iter().flatten().copied().collect()
+}

@@ -1,0 +1,178 @@
+//! The CPU rasterizer: the project's reference for overdraw counts.
+//!
+//! Rules, chosen to be exact, deterministic and what a Vulkan GPU does with one sample per pixel:
+//! - Vertices go through the camera's world → clip transform, the perspective divide and the
+//!   viewport transform to an R×R image with y up, then are snapped to 1/256 pixel (8 sub-pixel
+//!   bits, Vulkan's usual `subPixelPrecisionBits`). Everything after the snap is integer-exact.
+//! - Back faces are culled geometrically: a triangle is drawn only if its snapped projection is
+//!   counter-clockwise, i.e. its counter-clockwise normal points toward the viewer. Zero-area
+//!   projections are culled too.
+//! - A pixel is covered when its centre (i + ½, j + ½) is inside the triangle; a centre exactly on
+//!   an edge belongs to the triangle only if that edge is a *top* edge (horizontal, interior below)
+//!   or a *left* edge (interior to its right): the top-left rule, so a pixel on an edge shared by
+//!   two triangles is covered once.
+//! - Depth is the NDC z of the plane through the snapped vertices, evaluated at the pixel centre
+//!   in f32. The depth buffer is cleared to 1.0 per view; a fragment passes when z < stored (LESS),
+//!   in draw order, and then writes its depth.
+//!
+//! Per view it counts covered pixels, rasterized fragments and fragments that pass the depth test.
+//! Views run in parallel (rayon), each with its own depth buffer.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::views::Camera;
+use super::{RasterBackend, ViewCounts};
+use crate::error::{Error, Result};
+
+/// Sub-pixel bits of the snapped vertex coordinates.
+const SUBPIXEL_BITS: u32 = 8;
+const ONE: i64 = 1 << SUBPIXEL_BITS;
+const HALF: i64 = ONE / 2;
+/// Largest image side: keeps snapped coordinates and edge products far from i64 overflow.
+pub const MAX_RESOLUTION: u32 = 16384;
+
+/// The reference software rasterizer.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct CpuRaster;
+
+/// A vertex after projection and snapping: fixed-point window coordinates and NDC depth.
+#[derive(Clone, Copy, Default)]
+struct ScreenVertex {
+    x: i64,
+    y: i64,
+    z: f32,
+}
+
+impl RasterBackend for CpuRaster {
+    fn name(&self) -> &'static str {
+        "cpu"
+    }
+
+    fn count(
+        &self,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        cameras: &[Camera],
+        res: u32,
+    ) -> Result<Vec<ViewCounts>> {
+        if !(1..=MAX_RESOLUTION).contains(&res) {
+            return Err(Error::usage(format!("resolution {res} is outside 1..={MAX_RESOLUTION}")));
+        }
+        cameras
+            .par_iter()
+            .enumerate()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(screen, depth), (i, camera)| {
+                    project(positions, camera, res, screen).map_err(|why| Error::usage(format!("view {i}: {why}")))?;
+                    Ok(draw(screen, triangles, res, depth))
+                },
+            )
+            .collect()
+    }
+}
+
+/// Projects and snaps every vertex into `out`. Fails if a vertex lies outside the depth range
+/// (it would need clipping, which the view sets are framed never to need) or far off screen.
+fn project(
+    positions: &[Vec3],
+    camera: &Camera,
+    res: u32,
+    out: &mut Vec<ScreenVertex>,
+) -> std::result::Result<(), String> {
+    let scale = 0.5 * res as f32 * ONE as f32;
+    let limit = (8 * i64::from(res) * ONE) as f32;
+    out.clear();
+    out.reserve(positions.len());
+    for (i, p) in positions.iter().enumerate() {
+        let clip = camera.view_proj * p.extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        if !(clip.w > 0.0 && (0.0..=1.0).contains(&ndc.z)) {
+            return Err(format!("vertex {i} lies outside the camera's depth range (clipping is not supported)"));
+        }
+        let (x, y) = ((ndc.x + 1.0) * scale, (ndc.y + 1.0) * scale);
+        if !(x.abs() < limit && y.abs() < limit) {
+            return Err(format!("vertex {i} projects far outside the image"));
+        }
+        out.push(ScreenVertex { x: x.round() as i64, y: y.round() as i64, z: ndc.z });
+    }
+    Ok(())
+}
+
+/// An edge function `E(p) = (b − a) × (p − a)`, positive inside a counter-clockwise triangle,
+/// evaluated at the first pixel centre of a box and stepped per pixel.
+#[derive(Clone, Copy)]
+struct Edge {
+    /// Value at the current row start, minus 1 if the edge is not top-left (so `>= 0` tests inside).
+    row: i64,
+    step_x: i64,
+    step_y: i64,
+}
+
+impl Edge {
+    fn new(a: ScreenVertex, b: ScreenVertex, px: i64, py: i64) -> Edge {
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        // y up: a top edge runs right-to-left horizontally; a left edge runs downward.
+        let top_left = (dy == 0 && dx < 0) || dy < 0;
+        let value = dx * (py - a.y) - dy * (px - a.x);
+        Edge { row: value - i64::from(!top_left), step_x: -dy * ONE, step_y: dx * ONE }
+    }
+}
+
+/// Draws `triangles` in order into a cleared depth buffer and counts.
+fn draw(v: &[ScreenVertex], triangles: &[[u32; 3]], res: u32, depth: &mut Vec<f32>) -> ViewCounts {
+    let n = res as usize;
+    depth.clear();
+    depth.resize(n * n, 1.0);
+    let mut counts = ViewCounts::default();
+    let last = i64::from(res) - 1;
+    for tri in triangles {
+        let [a, b, c] = tri.map(|i| v[i as usize]);
+        let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+        if area <= 0 {
+            continue;
+        }
+        // Pixel index range whose centres (i·ONE + HALF) can lie inside the bounding box.
+        let first = |lo: i64| (lo - HALF + ONE - 1).div_euclid(ONE).max(0);
+        let final_ = |hi: i64| (hi - HALF).div_euclid(ONE).min(last);
+        let (x0, x1) = (first(a.x.min(b.x).min(c.x)), final_(a.x.max(b.x).max(c.x)));
+        let (y0, y1) = (first(a.y.min(b.y).min(c.y)), final_(a.y.max(b.y).max(c.y)));
+        if x0 > x1 || y0 > y1 {
+            continue;
+        }
+        let (px, py) = (x0 * ONE + HALF, y0 * ONE + HALF);
+        let mut edges = [Edge::new(b, c, px, py), Edge::new(c, a, px, py), Edge::new(a, b, px, py)];
+        // Depth plane z = za + dzdx·(x − ax) + dzdy·(y − ay), in pixel units, from the snapped vertices.
+        let inv_area = 1.0 / area as f64;
+        let (dz1, dz2) = (f64::from(b.z - a.z), f64::from(c.z - a.z));
+        let dzdx = ((dz1 * (c.y - a.y) as f64 - dz2 * (b.y - a.y) as f64) * inv_area * ONE as f64) as f32;
+        let dzdy = ((dz2 * (b.x - a.x) as f64 - dz1 * (c.x - a.x) as f64) * inv_area * ONE as f64) as f32;
+        // Offsets from vertex a stay small, so f32 keeps the plane accurate.
+        let (ax, ay) = (a.x as f32 / ONE as f32, a.y as f32 / ONE as f32);
+        for y in y0..=y1 {
+            let (mut e0, mut e1, mut e2) = (edges[0].row, edges[1].row, edges[2].row);
+            let row = y as usize * n;
+            let zy = a.z + dzdy * (y as f32 + 0.5 - ay);
+            for x in x0..=x1 {
+                if (e0 | e1 | e2) >= 0 {
+                    counts.fragments += 1;
+                    let z = zy + dzdx * (x as f32 + 0.5 - ax);
+                    let d = &mut depth[row + x as usize];
+                    if z < *d {
+                        counts.covered += u64::from(*d == 1.0);
+                        *d = z;
+                        counts.passed += 1;
+                    }
+                }
+                e0 += edges[0].step_x;
+                e1 += edges[1].step_x;
+                e2 += edges[2].step_x;
+            }
+            for e in &mut edges {
+                e.row += e.step_y;
+            }
+        }
+    }
+    counts
+}

@@ -1,0 +1,276 @@
+//! Cameras and the view sets every overdraw experiment is parameterised by.
+//!
+//! - `axis6`: orthographic along ±X, ±Y, ±Z.
+//! - `ico:N` (N = 10·4^m + 2: 12, 42, 162, 642, 2562): orthographic along the vertices of a
+//!   subdivided icosahedron (Nehab, Barczak & Sander 2006, §4 and Fig. 4), coarser sets first so
+//!   the sets nest.
+//! - `random:N`: N perspective cameras at 3× the bounding radius looking at the centre, uniformly
+//!   distributed directions from a seeded generator (Han & Sander 2017, §5).
+//!
+//! Framing is the same everywhere: the centre is the bounding-box centre and the radius r is the
+//! largest distance of any vertex from it. An orthographic view is a square of half-width r
+//! around the centre; a perspective camera has the vertical field of view 2·asin(1/3) ≈ 38.9°,
+//! which just fits the bounding sphere from distance 3r. Depth maps to 0..1 (the Vulkan/wgpu
+//! convention) with the near and far planes outside the bounding sphere, so no triangle is ever
+//! clipped (glam's right-handed view with `directx` projections: NDC y up, z in 0..1, as wgpu).
+//! The image's "up" is world +Y, or +Z when the view direction is within ~8° of ±Y.
+
+use std::fmt;
+use std::str::FromStr;
+
+use glam::camera::rh::{proj::directx, view::look_at_mat4};
+use glam::{Mat4, Vec3};
+use rand::{Rng, SeedableRng};
+
+use crate::error::{Error, Result};
+
+/// One view: a world → clip transform (depth 0..1, y up) and where the eye is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    pub view_proj: Mat4,
+    /// The viewpoint (for orthographic views: a point on the axis, outside the bounding sphere).
+    pub eye: Vec3,
+    /// Unit vector from the eye toward the model centre.
+    pub forward: Vec3,
+    pub perspective: bool,
+}
+
+/// How a model is framed: bounding-box centre and the largest vertex distance from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Framing {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl Framing {
+    pub fn of(positions: &[Vec3]) -> Framing {
+        let (lo, hi) = positions
+            .iter()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let center = (lo + hi) * 0.5;
+        let radius = positions.iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
+        // A single point or a degenerate mesh still needs a non-empty view volume.
+        Framing { center, radius: if radius > 0.0 { radius } else { 1.0 } }
+    }
+}
+
+/// A named set of views.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ViewSet {
+    Axis6,
+    Ico(u32),
+    Random(u32),
+}
+
+impl fmt::Display for ViewSet {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ViewSet::Axis6 => write!(f, "axis6"),
+            ViewSet::Ico(n) => write!(f, "ico:{n}"),
+            ViewSet::Random(n) => write!(f, "random:{n}"),
+        }
+    }
+}
+
+/// The icosahedron subdivision counts we generate: 10·4^m + 2 for m = 0..=4.
+const ICO_COUNTS: [u32; 5] = [12, 42, 162, 642, 2562];
+
+impl FromStr for ViewSet {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<ViewSet> {
+        let bad = |why: String| {
+            Error::usage(format!(
+                "view set `{text}` {why} (expected axis6, ico:N with N in 12, 42, 162, 642, 2562, or random:N)"
+            ))
+        };
+        match text.split_once(':') {
+            None if text == "axis6" => Ok(ViewSet::Axis6),
+            Some(("ico", n)) => match n.parse::<u32>() {
+                Ok(n) if ICO_COUNTS.contains(&n) => Ok(ViewSet::Ico(n)),
+                _ => Err(bad("is not an icosahedron subdivision count".into())),
+            },
+            Some(("random", n)) => match n.parse::<u32>() {
+                Ok(n) if (1..=100_000).contains(&n) => Ok(ViewSet::Random(n)),
+                _ => Err(bad("needs a count in 1..=100000".into())),
+            },
+            _ => Err(bad("is not a known view set".into())),
+        }
+    }
+}
+
+impl ViewSet {
+    pub fn len(&self) -> usize {
+        match *self {
+            ViewSet::Axis6 => 6,
+            ViewSet::Ico(n) | ViewSet::Random(n) => n as usize,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The cameras of this set framing `framing`; `seed` drives `random:N` only.
+    pub fn cameras(&self, framing: Framing, seed: u64) -> Vec<Camera> {
+        match *self {
+            ViewSet::Axis6 => [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z]
+                .into_iter()
+                .map(|d| orthographic(framing, d))
+                .collect(),
+            ViewSet::Ico(n) => icosphere_directions(n).into_iter().map(|d| orthographic(framing, d)).collect(),
+            ViewSet::Random(n) => {
+                let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+                (0..n).map(|_| perspective(framing, random_direction(&mut rng))).collect()
+            }
+        }
+    }
+}
+
+fn up_for(direction: Vec3) -> Vec3 {
+    if direction.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y }
+}
+
+/// Orthographic camera looking at the centre from `direction` (unit vector centre → eye).
+pub fn orthographic(framing: Framing, direction: Vec3) -> Camera {
+    let r = framing.radius;
+    let eye = framing.center + direction * (2.0 * r);
+    let view = look_at_mat4(eye, framing.center, up_for(direction));
+    let proj = directx::orthographic(-r, r, -r, r, 0.5 * r, 3.5 * r);
+    Camera { view_proj: proj * view, eye, forward: -direction, perspective: false }
+}
+
+/// Perspective camera at 3r from the centre along `direction`, fitting the bounding sphere.
+pub fn perspective(framing: Framing, direction: Vec3) -> Camera {
+    let r = framing.radius;
+    let eye = framing.center + direction * (3.0 * r);
+    let view = look_at_mat4(eye, framing.center, up_for(direction));
+    let fov_y = 2.0 * (1.0f32 / 3.0).asin();
+    let proj = directx::perspective(fov_y, 1.0, 1.0 * r, 5.0 * r);
+    Camera { view_proj: proj * view, eye, forward: -direction, perspective: true }
+}
+
+/// Uniform direction on the unit sphere (z uniform in [-1, 1], azimuth uniform).
+fn random_direction(rng: &mut impl Rng) -> Vec3 {
+    let z: f32 = rng.random_range(-1.0..=1.0);
+    let phi: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    Vec3::new(s * phi.cos(), s * phi.sin(), z)
+}
+
+/// Unit directions of the icosahedron subdivided until it has `n` vertices, coarser levels first
+/// (each level keeps the previous level's vertices in place and appends the edge midpoints).
+pub fn icosphere_directions(n: u32) -> Vec<Vec3> {
+    let phi = (1.0 + 5.0f32.sqrt()) / 2.0;
+    let mut points: Vec<Vec3> = [
+        (-1.0, phi, 0.0),
+        (1.0, phi, 0.0),
+        (-1.0, -phi, 0.0),
+        (1.0, -phi, 0.0),
+        (0.0, -1.0, phi),
+        (0.0, 1.0, phi),
+        (0.0, -1.0, -phi),
+        (0.0, 1.0, -phi),
+        (phi, 0.0, -1.0),
+        (phi, 0.0, 1.0),
+        (-phi, 0.0, -1.0),
+        (-phi, 0.0, 1.0),
+    ]
+    .into_iter()
+    .map(|(x, y, z)| Vec3::new(x, y, z).normalize())
+    .collect();
+    let mut faces: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    while points.len() < n as usize {
+        let mut midpoint = std::collections::HashMap::new();
+        let mut split = |a: usize, b: usize, points: &mut Vec<Vec3>| {
+            *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                points.push((points[a] + points[b]).normalize());
+                points.len() - 1
+            })
+        };
+        faces = faces
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (split(a, b, &mut points), split(b, c, &mut points), split(c, a, &mut points));
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn icosphere_counts_nest_and_are_unit() {
+        for n in ICO_COUNTS {
+            let d = icosphere_directions(n);
+            assert_eq!(d.len(), n as usize);
+            assert!(d.iter().all(|v| (v.length() - 1.0).abs() < 1e-5));
+        }
+        assert_eq!(icosphere_directions(42)[..12], icosphere_directions(12)[..]);
+        // Neighbouring directions of ico:162 are ~17° apart: no duplicates.
+        let d = icosphere_directions(162);
+        let min_angle = (0..d.len())
+            .flat_map(|i| (i + 1..d.len()).map(move |j| (i, j)))
+            .map(|(i, j)| d[i].angle_between(d[j]))
+            .fold(f32::MAX, f32::min);
+        assert!(min_angle > 0.25, "{min_angle}");
+    }
+
+    #[test]
+    fn cameras_frame_the_bounding_sphere() {
+        let framing = Framing { center: Vec3::new(1.0, 2.0, 3.0), radius: 2.0 };
+        for set in ["axis6", "ico:42", "random:50"] {
+            for cam in set.parse::<ViewSet>().unwrap().cameras(framing, 7) {
+                // Sphere points project inside the unit square and strictly inside the depth range.
+                for d in icosphere_directions(162) {
+                    let clip = cam.view_proj * (framing.center + d * framing.radius).extend(1.0);
+                    let ndc = clip.truncate() / clip.w;
+                    assert!(ndc.x.abs() <= 1.0001 && ndc.y.abs() <= 1.0001, "{set}: {ndc}");
+                    assert!(ndc.z > 0.0 && ndc.z < 1.0, "{set}: {ndc}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn random_views_are_seeded() {
+        let f = Framing { center: Vec3::ZERO, radius: 1.0 };
+        let a = ViewSet::Random(5).cameras(f, 1);
+        assert_eq!(a, ViewSet::Random(5).cameras(f, 1));
+        assert_ne!(a, ViewSet::Random(5).cameras(f, 2));
+        assert!(a.iter().all(|c| (c.eye.length() - 3.0).abs() < 1e-5));
+    }
+
+    #[test]
+    fn parse_errors() {
+        for bad in ["ico:100", "random:0", "axis7", "ico", "sphere:4"] {
+            assert!(bad.parse::<ViewSet>().unwrap_err().to_string().contains(bad));
+        }
+        assert_eq!("ico:642".parse::<ViewSet>().unwrap().to_string(), "ico:642");
+    }
+}
