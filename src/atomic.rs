@@ -18,9 +18,12 @@ pub fn write_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Res
     if path.is_dir() {
         return Err(Error::output(path, "is a directory"));
     }
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".triorder-")
-        .suffix(".tmp")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".triorder-").suffix(".tmp");
+    // tempfile creates 0600 files; an output should get the usual 0666 minus umask.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder
         .tempfile_in(dir)
         .map_err(|e| Error::output(path, e))?;
     {
