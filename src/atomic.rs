@@ -23,9 +23,7 @@ pub fn write_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Res
     // tempfile creates 0600 files; an output should get the usual 0666 minus umask.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder
-        .tempfile_in(dir)
-        .map_err(|e| Error::output(path, e))?;
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| Error::output(path, e))?;
     {
         let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut buffered).and_then(|()| buffered.flush()).map_err(|e| Error::output(path, e))?;

@@ -5,7 +5,17 @@
 //! cache simulators and the overdraw counter ([`metrics`], [`raster`]), and swept by experiment
 //! specs into CSV and SVG ([`experiment`], [`figure`]).
 
+pub mod atomic;
+pub mod bench;
 pub mod error;
+pub mod eval;
+pub mod experiment;
+pub mod figure;
 pub mod mesh;
 
 pub use error::{Error, Result};
+pub mod metrics;
+pub mod order;
+pub mod peer;
+pub mod raster;
+pub mod topology;

@@ -1,1 +1,149 @@
-fn main() {}
+//! The `triorder` command line: thin wrappers over the library, one function per subcommand in
+//! `commands/`. Every error is printed as `error: FILE: problem` on stderr with exit status 2.
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+/// Triangle-order optimization: reorder meshes, measure vertex-cache misses and overdraw, and
+/// regenerate the figures of the triangle-ordering papers.
+#[derive(Parser)]
+#[command(name = "triorder", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options shared by every command that reads meshes.
+#[derive(Args, Clone)]
+struct Common {
+    /// Directory that model paths are resolved against (default: $TRIORDER_DATA, else
+    /// ../shared/data if it exists). scripts/fetch-data.sh downloads the public models.
+    #[arg(long, value_name = "DIR", global = true)]
+    data: Option<PathBuf>,
+    /// Seed for randomised methods (`random`), seeded meshes (`disk:N`) and `random:N` views.
+    #[arg(long, default_value_t = 0, global = true)]
+    seed: u64,
+}
+
+/// What to measure, as in `eval` and `order`.
+#[derive(Args, Clone)]
+struct Measure {
+    /// Vertex-cache model(s): fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP. Repeatable; the first
+    /// is the one summarised. Default fifo:16.
+    #[arg(long = "cache", value_name = "MODEL")]
+    caches: Vec<String>,
+    /// Measure overdraw over a view set: axis6, ico:N (12, 42, 162, 642, 2562) or random:N.
+    #[arg(long, value_name = "SET")]
+    views: Option<String>,
+    /// Image side in pixels for overdraw.
+    #[arg(long, default_value_t = 512)]
+    res: u32,
+    /// Raster backend for overdraw.
+    #[arg(long, default_value = "cpu")]
+    backend: String,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List every ordering method with its parameters, defaults and source paper or library.
+    Methods,
+    /// Reorder a mesh file and write it (OBJ, PLY or GLB, by extension), attributes preserved.
+    ///
+    /// Prints the ACMR before and after (and OVR with --views). The output is written
+    /// atomically: on any failure no partial file is left.
+    Order {
+        /// Input mesh: a file (OBJ, PLY, GLB/glTF) or a procedural spec such as grid:16x8.
+        input: String,
+        /// Output file; its extension picks the format.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Ordering method with parameters, e.g. meshopt-overdraw:threshold=1.05.
+        #[arg(short, long, default_value = "meshopt-vcache")]
+        method: String,
+        /// Also renumber vertices in first-use order (vertex-fetch locality).
+        #[arg(long)]
+        remap_vertices: bool,
+        #[command(flatten)]
+        measure: Measure,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Order a mesh with one or more methods and measure each order.
+    Eval {
+        /// Mesh file or procedural spec.
+        mesh: String,
+        /// Method spec(s), repeatable. Default: input.
+        #[arg(short, long = "method", value_name = "SPEC")]
+        methods: Vec<String>,
+        #[command(flatten)]
+        measure: Measure,
+        /// One JSON object per method per line instead of a table.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Run an experiment spec (experiments/*.toml) and write results/ID.csv.
+    Run {
+        spec: PathBuf,
+        /// Small models and views (seconds); writes under results/quick/.
+        #[arg(long)]
+        quick: bool,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Draw paper-figures/ID.svg from results/ID.csv (no recomputation).
+    Plot {
+        spec: PathBuf,
+        /// Plot the quick run's CSV into paper-figures/quick/.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Run and plot every experiment in experiments/.
+    Reproduce {
+        /// Small models and views only: works on a fresh clone with no data directory.
+        #[arg(long)]
+        quick: bool,
+        /// Only the experiment with this id.
+        #[arg(long, value_name = "ID")]
+        only: Option<String>,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Time our metrics against meshoptimizer (the meshopt crate) in the same run.
+    Bench {
+        /// Repetitions per timing (the median is reported).
+        #[arg(long, default_value_t = 11)]
+        reps: usize,
+        #[command(flatten)]
+        common: Common,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Methods => commands::methods(),
+        Command::Order { input, output, method, remap_vertices, measure, common } => {
+            commands::order(&input, &output, &method, remap_vertices, &measure, &common)
+        }
+        Command::Eval { mesh, methods, measure, json, common } => {
+            commands::eval(&mesh, &methods, &measure, json, &common)
+        }
+        Command::Run { spec, quick, common } => commands::run(&spec, quick, &common),
+        Command::Plot { spec, quick } => commands::plot(&spec, quick),
+        Command::Reproduce { quick, only, common } => commands::reproduce(quick, only.as_deref(), &common),
+        Command::Bench { reps, common } => commands::bench(reps, &common),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

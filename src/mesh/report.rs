@@ -90,3 +90,33 @@ impl fmt::Display for MeshReport {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::VertexAttributes;
+    use glam::Vec3;
+
+    #[test]
+    fn irregularities_are_counted_not_dropped() {
+        let positions = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [2., 0., 0.], [0., 0., 1.], [5., 5., 5.]]
+            .map(Vec3::from)
+            .to_vec();
+        let triangles = vec![
+            [0, 1, 2],
+            [2, 1, 0], // duplicate of the first (reversed)
+            [0, 0, 1], // repeated index
+            [0, 1, 3], // zero area (collinear)
+            [0, 1, 4], // third triangle on edge 0-1 with the first two: non-manifold
+        ];
+        let mesh = Mesh::new("m", positions, triangles, VertexAttributes::default()).unwrap();
+        let report = MeshReport::new(&mesh, &Topology::new(&mesh));
+        assert_eq!(report.triangles, 5);
+        assert_eq!((report.repeated_index, report.zero_area, report.duplicates), (1, 1, 1));
+        assert_eq!(report.non_manifold_edges, 1);
+        assert_eq!(report.unused_vertices, 1);
+        let text = report.to_string();
+        assert!(text.contains("1 duplicate triangles; kept as given"), "{text}");
+        assert!(text.contains("non-manifold"), "{text}");
+    }
+}

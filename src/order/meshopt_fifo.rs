@@ -32,6 +32,6 @@ impl Ordering for MeshoptFifo {
     fn order(&self, input: &OrderInput) -> Result<Order> {
         let mesh = input.mesh;
         let indices = meshopt::optimize_vertex_cache_fifo(&peer::index_buffer(mesh), mesh.vertex_count(), self.cache);
-        peer::order_from_index_buffer(mesh, &indices)
+        peer::order_from_index_buffer(mesh, input.topology, &indices)
     }
 }

@@ -34,6 +34,6 @@ impl Ordering for MeshoptOverdraw {
         let mesh = input.mesh;
         let mut indices = meshopt::optimize_vertex_cache(&peer::index_buffer(mesh), mesh.vertex_count());
         meshopt::optimize_overdraw_in_place(&mut indices, &peer::positions(mesh), self.threshold);
-        peer::order_from_index_buffer(mesh, &indices)
+        peer::order_from_index_buffer(mesh, input.topology, &indices)
     }
 }

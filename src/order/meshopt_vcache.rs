@@ -25,6 +25,6 @@ impl Ordering for MeshoptVcache {
     fn order(&self, input: &OrderInput) -> Result<Order> {
         let mesh = input.mesh;
         let indices = meshopt::optimize_vertex_cache(&peer::index_buffer(mesh), mesh.vertex_count());
-        peer::order_from_index_buffer(mesh, &indices)
+        peer::order_from_index_buffer(mesh, input.topology, &indices)
     }
 }

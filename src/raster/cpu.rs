@@ -39,8 +39,8 @@ pub struct CpuRaster;
 /// A vertex after projection and snapping: fixed-point window coordinates and NDC depth.
 #[derive(Clone, Copy, Default)]
 struct ScreenVertex {
-    x: i64,
-    y: i64,
+    x: i32,
+    y: i32,
     z: f32,
 }
 
@@ -95,7 +95,7 @@ fn project(
         if !(x.abs() < limit && y.abs() < limit) {
             return Err(format!("vertex {i} projects far outside the image"));
         }
-        out.push(ScreenVertex { x: x.round() as i64, y: y.round() as i64, z: ndc.z });
+        out.push(ScreenVertex { x: x.round() as i32, y: y.round() as i32, z: ndc.z });
     }
     Ok(())
 }
@@ -112,10 +112,10 @@ struct Edge {
 
 impl Edge {
     fn new(a: ScreenVertex, b: ScreenVertex, px: i64, py: i64) -> Edge {
-        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let (dx, dy) = (i64::from(b.x - a.x), i64::from(b.y - a.y));
         // y up: a top edge runs right-to-left horizontally; a left edge runs downward.
         let top_left = (dy == 0 && dx < 0) || dy < 0;
-        let value = dx * (py - a.y) - dy * (px - a.x);
+        let value = dx * (py - i64::from(a.y)) - dy * (px - i64::from(a.x));
         Edge { row: value - i64::from(!top_left), step_x: -dy * ONE, step_y: dx * ONE }
     }
 }
@@ -129,16 +129,19 @@ fn draw(v: &[ScreenVertex], triangles: &[[u32; 3]], res: u32, depth: &mut Vec<f3
     let last = i64::from(res) - 1;
     for tri in triangles {
         let [a, b, c] = tri.map(|i| v[i as usize]);
-        let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-        if area <= 0 {
-            continue;
-        }
-        // Pixel index range whose centres (i·ONE + HALF) can lie inside the bounding box.
-        let first = |lo: i64| (lo - HALF + ONE - 1).div_euclid(ONE).max(0);
-        let final_ = |hi: i64| (hi - HALF).div_euclid(ONE).min(last);
+        // Pixel index range whose centres (i·ONE + HALF) can lie inside the bounding box; most
+        // triangles of a dense mesh cover no centre and stop here.
+        let first = |lo: i32| (i64::from(lo) - HALF + ONE - 1).div_euclid(ONE).max(0);
+        let final_ = |hi: i32| (i64::from(hi) - HALF).div_euclid(ONE).min(last);
         let (x0, x1) = (first(a.x.min(b.x).min(c.x)), final_(a.x.max(b.x).max(c.x)));
         let (y0, y1) = (first(a.y.min(b.y).min(c.y)), final_(a.y.max(b.y).max(c.y)));
         if x0 > x1 || y0 > y1 {
+            continue;
+        }
+        let (abx, aby) = (i64::from(b.x - a.x), i64::from(b.y - a.y));
+        let (acx, acy) = (i64::from(c.x - a.x), i64::from(c.y - a.y));
+        let area = abx * acy - aby * acx;
+        if area <= 0 {
             continue;
         }
         let (px, py) = (x0 * ONE + HALF, y0 * ONE + HALF);
@@ -146,8 +149,8 @@ fn draw(v: &[ScreenVertex], triangles: &[[u32; 3]], res: u32, depth: &mut Vec<f3
         // Depth plane z = za + dzdx·(x − ax) + dzdy·(y − ay), in pixel units, from the snapped vertices.
         let inv_area = 1.0 / area as f64;
         let (dz1, dz2) = (f64::from(b.z - a.z), f64::from(c.z - a.z));
-        let dzdx = ((dz1 * (c.y - a.y) as f64 - dz2 * (b.y - a.y) as f64) * inv_area * ONE as f64) as f32;
-        let dzdy = ((dz2 * (b.x - a.x) as f64 - dz1 * (c.x - a.x) as f64) * inv_area * ONE as f64) as f32;
+        let dzdx = ((dz1 * acy as f64 - dz2 * aby as f64) * inv_area * ONE as f64) as f32;
+        let dzdy = ((dz2 * abx as f64 - dz1 * acx as f64) * inv_area * ONE as f64) as f32;
         // Offsets from vertex a stay small, so f32 keeps the plane accurate.
         let (ax, ay) = (a.x as f32 / ONE as f32, a.y as f32 / ONE as f32);
         for y in y0..=y1 {

@@ -1,0 +1,67 @@
+//! `run`, `plot`, `reproduce` and `bench`: experiment specs to CSV to SVG, and speed vs meshopt.
+
+use std::path::Path;
+
+use triorder::Result;
+use triorder::experiment::{self, RunOptions, provenance};
+use triorder::figure::{self, PlotOptions};
+use triorder::mesh::source;
+
+use crate::Common;
+
+fn run_options(quick: bool, common: &Common) -> RunOptions {
+    RunOptions { quick, data: common.data.clone(), progress: true, ..Default::default() }
+}
+
+pub fn run(spec: &Path, quick: bool, common: &Common) -> Result<()> {
+    let csv = experiment::run(spec, &run_options(quick, common))?;
+    println!("wrote {}", csv.display());
+    Ok(())
+}
+
+pub fn plot(spec: &Path, quick: bool) -> Result<()> {
+    let svg = figure::plot(spec, &PlotOptions { quick, ..Default::default() })?;
+    println!("wrote {}", svg.display());
+    Ok(())
+}
+
+pub fn reproduce(quick: bool, only: Option<&str>, common: &Common) -> Result<()> {
+    for (csv, svg) in experiment::reproduce(&run_options(quick, common), only)? {
+        println!("wrote {} and {}", csv.display(), svg.display());
+    }
+    Ok(())
+}
+
+/// The meshes `bench` times: the large shared models when a data directory exists, else a
+/// procedural sphere of similar size and the bundled cow.
+const BENCH_MODELS: [&str; 3] =
+    ["models/bun_zipper.ply", "models/happy_buddha_100k.obj", "models/dragon_vrip_res2.ply"];
+const BENCH_FALLBACK: [&str; 2] = ["sphere:100000", "assets/spot.obj"];
+
+pub fn bench(reps: usize, common: &Common) -> Result<()> {
+    let data = source::data_dir(common.data.as_deref());
+    let models: &[&str] = if data.is_some() { &BENCH_MODELS } else { &BENCH_FALLBACK };
+    println!("machine: {}", provenance::machine());
+    println!("median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster)\n");
+    println!(
+        "{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",
+        "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup"
+    );
+    for model in models {
+        let mesh = source::open(model, data.as_deref(), common.seed)?;
+        for r in triorder::bench::compare(&mesh, reps) {
+            let theirs = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.3}", s * 1e3));
+            let speedup = r.speedup().map_or("-".to_string(), |s| format!("{s:.2}x"));
+            println!(
+                "{:<28} {:>9}  {:<46} {:>10.3} {:>10} {:>8}",
+                model,
+                r.triangles,
+                r.task,
+                r.ours_seconds * 1e3,
+                theirs,
+                speedup
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,121 @@
+//! One function per subcommand. Each parses its strings into library types up front (so a bad
+//! method, cache or view set fails before any work), calls the library, and prints.
+
+mod experiments;
+mod tables;
+
+pub use experiments::{bench, plot, reproduce, run};
+
+use std::path::Path;
+
+use triorder::eval::{self, MeasureOptions};
+use triorder::mesh::{self, Mesh, report::MeshReport};
+use triorder::metrics::CacheModel;
+use triorder::order::{self, METHODS, params::describe_kind};
+use triorder::raster::{self, RasterBackend, ViewSet};
+use triorder::topology::Topology;
+use triorder::{Error, Result};
+
+use crate::{Common, Measure};
+
+/// Parsed measurement options plus the chosen backend.
+struct Measuring {
+    options: MeasureOptions,
+    raster: Box<dyn RasterBackend>,
+}
+
+impl Measuring {
+    fn new(m: &Measure, seed: u64) -> Result<Measuring> {
+        let caches = if m.caches.is_empty() {
+            vec![CacheModel::Fifo(16)]
+        } else {
+            m.caches.iter().map(|c| c.parse()).collect::<Result<_>>()?
+        };
+        let views = m.views.as_deref().map(str::parse::<ViewSet>).transpose()?;
+        let raster = raster::backend(&m.backend)?;
+        Ok(Measuring { options: MeasureOptions { caches, views, res: m.res, seed }, raster })
+    }
+}
+
+/// Loads a mesh, derives its topology and prints what is unusual about it on stderr.
+fn open(source: &str, common: &Common) -> Result<(Mesh, Topology)> {
+    let data = mesh::source::data_dir(common.data.as_deref());
+    let mesh = mesh::source::open(source, data.as_deref(), common.seed)?;
+    let topology = Topology::new(&mesh);
+    let report = MeshReport::new(&mesh, &topology);
+    eprintln!("{source}: {report}");
+    Ok((mesh, topology))
+}
+
+pub fn methods() -> Result<()> {
+    for m in METHODS {
+        let peer = if m.peer { "  [peer]" } else { "" };
+        println!("{}{peer}\n    {}\n    source: {}", m.name, m.summary, m.source);
+        for p in m.params {
+            let default = if matches!(p.kind, order::ParamKind::Seed) { "--seed" } else { p.default };
+            println!("    {}={default}  ({}) {}", p.name, describe_kind(p.kind), p.help);
+        }
+        println!();
+    }
+    Ok(())
+}
+
+pub fn eval(source: &str, methods: &[String], measure: &Measure, json: bool, common: &Common) -> Result<()> {
+    let measuring = Measuring::new(measure, common.seed)?;
+    let specs: Vec<&str> =
+        if methods.is_empty() { vec!["input"] } else { methods.iter().map(String::as_str).collect() };
+    let resolved = specs.iter().map(|s| order::resolve(s, common.seed)).collect::<Result<Vec<_>>>()?;
+    let (mesh, topology) = open(source, common)?;
+    let mut table = tables::EvalTable::new(&measuring.options);
+    for method in &resolved {
+        let e = eval::evaluate(&mesh, &topology, method, &measuring.options, measuring.raster.as_ref())?;
+        if json {
+            println!("{}", tables::eval_json(&mesh, &e, measuring.raster.name()));
+        } else {
+            table.push(&e);
+        }
+    }
+    if !json {
+        print!("{}", table.render(&mesh));
+    }
+    Ok(())
+}
+
+pub fn order(
+    source: &str,
+    output: &Path,
+    method: &str,
+    remap_vertices: bool,
+    measure: &Measure,
+    common: &Common,
+) -> Result<()> {
+    let measuring = Measuring::new(measure, common.seed)?;
+    let resolved = order::resolve(method, common.seed)?;
+    if output.is_dir() {
+        return Err(Error::output(output, "is a directory"));
+    }
+    if mesh::save::format_of(output).is_none() {
+        return Err(Error::output(output, "unknown output format (use .obj, .ply or .glb)"));
+    }
+    let (mesh, topology) = open(source, common)?;
+    let identity: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
+    let before = eval::measure(&mesh, &identity, &measuring.options, measuring.raster.as_ref())?;
+    let after = eval::evaluate(&mesh, &topology, &resolved, &measuring.options, measuring.raster.as_ref())?;
+    let mut reordered = mesh.reordered(&after.order);
+    if remap_vertices {
+        reordered = reordered.remap_vertices_first_use();
+    }
+    let saved = mesh::save::save(&reordered, output)?;
+    for dropped in &saved.dropped {
+        eprintln!("warning: {}: not written: {dropped}", output.display());
+    }
+    println!("{}", tables::before_after(&before, &after));
+    println!(
+        "wrote {} ({} triangles, {} ordered in {:.3} s)",
+        output.display(),
+        reordered.triangle_count(),
+        after.method,
+        after.seconds
+    );
+    Ok(())
+}

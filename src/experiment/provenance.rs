@@ -1,0 +1,35 @@
+//! Where results came from: the machine and the code, recorded in every CSV row so a number can
+//! be trusted (or questioned) without asking who ran it.
+
+/// `CPU model name (N threads)` from /proc/cpuinfo, else the target architecture and OS.
+pub fn machine() -> String {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cpu = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|info| {
+        info.lines()
+            .find(|l| l.starts_with("model name"))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, name)| name.split_whitespace().collect::<Vec<_>>().join(" "))
+    });
+    let cpu = cpu.unwrap_or_else(|| format!("{} {}", std::env::consts::ARCH, std::env::consts::OS));
+    format!("{cpu} ({threads} threads)")
+}
+
+/// `git rev-parse --short HEAD` of the working directory, `-dirty` when the tree has changes,
+/// `unknown` outside git (or before the first commit).
+pub fn commit() -> String {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match git(&["rev-parse", "--short", "HEAD"]) {
+        None => "unknown".into(),
+        Some(hash) => match git(&["status", "--porcelain"]) {
+            Some(changes) if !changes.is_empty() => format!("{hash}-dirty"),
+            _ => hash,
+        },
+    }
+}

@@ -1,0 +1,207 @@
+//! The results CSV: one row per measurement, in long ("tidy") form.
+//!
+//! Every number of a run is its own row, named by `metric` and described by the columns that
+//! vary (model, method, cache, view), so one plotter serves every figure: a figure picks a
+//! metric, an x column, a series column and a facet column. Each row also carries what is needed
+//! to trust and reproduce it: model size, the method's canonical spec (every parameter), seed,
+//! backend, machine, commit and triorder version.
+
+use serde::Serialize;
+
+use crate::eval::Evaluation;
+use crate::mesh::Mesh;
+
+/// The CSV header, in order (checked against [`Row`] by a test).
+pub const COLUMNS: &[&str] = &[
+    "experiment",
+    "model",
+    "model_triangles",
+    "model_vertices",
+    "method",
+    "method_name",
+    "peer",
+    "seed",
+    "metric",
+    "cache",
+    "cache_kind",
+    "cache_size",
+    "views",
+    "res",
+    "view",
+    "backend",
+    "value",
+    "seconds",
+    "machine",
+    "commit",
+    "triorder",
+];
+
+/// What a metric's rows need from the spec.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Needs {
+    Nothing,
+    Caches,
+    Views,
+}
+
+/// A metric a run writes: its name in the `metric` column and how an axis labels it.
+#[derive(Debug, Clone, Copy)]
+pub struct Metric {
+    pub name: &'static str,
+    pub label: &'static str,
+    pub needs: Needs,
+}
+
+/// Every metric a run writes. Cache metrics come once per cache model; overdraw summaries once
+/// per view set; `ovr` once per view that sees the mesh (empty views have no ratio and are
+/// counted by `ovr_empty` instead).
+pub const METRICS: &[Metric] = &[
+    Metric { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: Needs::Caches },
+    Metric { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: Needs::Caches },
+    Metric { name: "seconds", label: "ordering time (s)", needs: Needs::Nothing },
+    Metric { name: "ovr", label: "overdraw ratio (shaded ÷ covered pixels)", needs: Needs::Views },
+    Metric { name: "ovr_mean", label: "mean overdraw ratio over views", needs: Needs::Views },
+    Metric { name: "ovr_max", label: "worst-view overdraw ratio", needs: Needs::Views },
+    Metric { name: "ovr_min", label: "best-view overdraw ratio", needs: Needs::Views },
+    Metric { name: "ovr_var", label: "variance of the overdraw ratio over views", needs: Needs::Views },
+    Metric { name: "ovr_sum", label: "overdraw ratio (Σ shaded ÷ Σ covered)", needs: Needs::Views },
+    Metric { name: "ovr_empty", label: "views that see nothing", needs: Needs::Views },
+];
+
+/// One measurement. Field order is the column order ([`COLUMNS`]); `None` writes an empty cell.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    pub experiment: String,
+    pub model: String,
+    pub model_triangles: usize,
+    pub model_vertices: usize,
+    /// Canonical method spec (every parameter).
+    pub method: String,
+    pub method_name: String,
+    pub peer: bool,
+    pub seed: u64,
+    pub metric: &'static str,
+    pub cache: Option<String>,
+    pub cache_kind: Option<&'static str>,
+    pub cache_size: Option<u32>,
+    pub views: Option<String>,
+    pub res: Option<u32>,
+    /// Index of the view in its set, for per-view metrics.
+    pub view: Option<usize>,
+    pub backend: String,
+    pub value: f64,
+    /// Wall time of the ordering alone.
+    pub seconds: f64,
+    pub machine: String,
+    pub commit: String,
+    pub triorder: &'static str,
+}
+
+/// Where and with what a run happened: the columns shared by all its rows.
+#[derive(Debug, Clone)]
+pub struct Context {
+    pub experiment: String,
+    pub seed: u64,
+    pub backend: String,
+    pub machine: String,
+    pub commit: String,
+}
+
+impl Context {
+    /// The rows of one evaluation of `model` (as the spec names it).
+    pub fn rows(&self, model: &str, mesh: &Mesh, method_name: &str, eval: &Evaluation) -> Vec<Row> {
+        let base = Row {
+            experiment: self.experiment.clone(),
+            model: model.to_string(),
+            model_triangles: mesh.triangle_count(),
+            model_vertices: mesh.vertex_count(),
+            method: eval.method.clone(),
+            method_name: method_name.to_string(),
+            peer: eval.peer,
+            seed: self.seed,
+            metric: "seconds",
+            cache: None,
+            cache_kind: None,
+            cache_size: None,
+            views: None,
+            res: None,
+            view: None,
+            backend: self.backend.clone(),
+            value: eval.seconds,
+            seconds: eval.seconds,
+            machine: self.machine.clone(),
+            commit: self.commit.clone(),
+            triorder: env!("CARGO_PKG_VERSION"),
+        };
+        let mut rows = Vec::new();
+        for (model, stats) in &eval.measurement.caches {
+            let cache = Row {
+                cache: Some(model.to_string()),
+                cache_kind: Some(model.kind()),
+                cache_size: Some(model.size()),
+                ..base.clone()
+            };
+            rows.push(Row { metric: "acmr", value: stats.acmr(), ..cache.clone() });
+            rows.push(Row { metric: "atvr", value: stats.atvr(), ..cache });
+        }
+        if let Some(overdraw) = &eval.measurement.overdraw {
+            let views = Row { views: Some(overdraw.views.to_string()), res: Some(overdraw.res), ..base.clone() };
+            let empty = overdraw.per_view.iter().filter(|v| v.ovr().is_none()).count();
+            rows.push(Row { metric: "ovr_empty", value: empty as f64, ..views.clone() });
+            if let Some(s) = &overdraw.summary {
+                for (metric, value) in [
+                    ("ovr_mean", s.mean),
+                    ("ovr_max", s.max),
+                    ("ovr_min", s.min),
+                    ("ovr_var", s.variance),
+                    ("ovr_sum", s.ratio_of_sums),
+                ] {
+                    rows.push(Row { metric, value, ..views.clone() });
+                }
+            }
+            for (i, counts) in overdraw.per_view.iter().enumerate() {
+                if let Some(value) = counts.ovr() {
+                    rows.push(Row { metric: "ovr", view: Some(i), value, ..views.clone() });
+                }
+            }
+        }
+        rows.push(base);
+        rows
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_matches_columns() {
+        let row = Row {
+            experiment: String::new(),
+            model: String::new(),
+            model_triangles: 0,
+            model_vertices: 0,
+            method: String::new(),
+            method_name: String::new(),
+            peer: false,
+            seed: 0,
+            metric: "acmr",
+            cache: None,
+            cache_kind: None,
+            cache_size: None,
+            views: None,
+            res: None,
+            view: None,
+            backend: String::new(),
+            value: 0.0,
+            seconds: 0.0,
+            machine: String::new(),
+            commit: String::new(),
+            triorder: "",
+        };
+        let mut writer = csv::Writer::from_writer(Vec::new());
+        writer.serialize(&row).unwrap();
+        let text = String::from_utf8(writer.into_inner().unwrap()).unwrap();
+        assert_eq!(text.lines().next().unwrap(), COLUMNS.join(","));
+    }
+}

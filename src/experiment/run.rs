@@ -1,0 +1,178 @@
+//! Running a spec: models × methods, each ordered once and measured with every cache model and
+//! the view set, one CSV row per number.
+//!
+//! Models are handled one at a time (load, topology, then every method) so memory stays that of
+//! the largest model. Orderings run one after another so their wall times are honest; only the
+//! rasterizer runs in parallel, inside one measurement. The CSV is written atomically at the end:
+//! an interrupted run leaves the previous results untouched.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::provenance;
+use super::row::{Context, Row};
+use super::spec::Spec;
+use crate::error::{Error, Result};
+use crate::eval::{MeasureOptions, evaluate};
+use crate::mesh::report::MeshReport;
+use crate::mesh::{procedural, source};
+use crate::order;
+use crate::topology::Topology;
+use crate::{atomic, figure, raster};
+
+/// How to run (and, for [`reproduce`], plot) experiments.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Run the spec's `[quick]` table: writes `results/quick/` and `paper-figures/quick/`.
+    pub quick: bool,
+    /// The data directory models are looked up in (else `TRIORDER_DATA`, else `../shared/data`).
+    pub data: Option<PathBuf>,
+    /// Progress bars on stderr (drawn only when stderr is a terminal).
+    pub progress: bool,
+    /// The project root: [`reproduce`] reads `experiments/` in it, and `results/` and
+    /// `paper-figures/` are written under it.
+    pub out_dir: PathBuf,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions { quick: false, data: None, progress: false, out_dir: PathBuf::from(".") }
+    }
+}
+
+/// Runs the spec at `spec` and writes its CSV; returns the CSV's path.
+pub fn run(spec: &Path, opts: &RunOptions) -> Result<PathBuf> {
+    let spec = Spec::load(spec)?;
+    run_spec(&spec, opts, &bars(opts.progress))
+}
+
+/// Runs and plots every `experiments/*.toml` under `opts.out_dir` whose id contains `filter`, in
+/// file-name order; returns each `(csv, svg)`. Every spec is loaded and checked before the first
+/// one runs, so a typo in the last spec does not surface after an hour of work.
+pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Vec<(PathBuf, PathBuf)>> {
+    let dir = opts.out_dir.join("experiments");
+    let entries =
+        std::fs::read_dir(&dir).map_err(|e| Error::input(dir.display(), format!("cannot list experiments: {e}")))?;
+    let mut paths = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| Error::input(dir.display(), e))?.path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    let all = paths.len();
+    paths.retain(|p| filter.is_none_or(|f| p.file_stem().is_some_and(|s| s.to_string_lossy().contains(f))));
+    if paths.is_empty() {
+        let what = filter.map_or(String::new(), |f| format!(" matching `{f}` (of {all})"));
+        return Err(Error::usage(format!("no experiment specs{what} in {}", dir.display())));
+    }
+    let specs = paths.iter().map(|p| Spec::load(p)).collect::<Result<Vec<_>>>()?;
+    for spec in &specs {
+        spec.workload(opts.quick)?;
+    }
+    let bars = bars(opts.progress);
+    let overall = bars.add(ProgressBar::new(specs.len() as u64));
+    overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));
+    let plot = figure::PlotOptions { quick: opts.quick, out_dir: opts.out_dir.clone() };
+    let mut outputs = Vec::new();
+    for spec in &specs {
+        overall.set_message(spec.id.clone());
+        let csv = run_spec(spec, opts, &bars)?;
+        let svg = figure::plot_spec(spec, &plot)?;
+        outputs.push((csv, svg));
+        overall.inc(1);
+    }
+    overall.finish_and_clear();
+    Ok(outputs)
+}
+
+/// Runs a loaded spec, showing its progress bar among `bars`.
+fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<PathBuf> {
+    let work = spec.workload(opts.quick)?;
+    let data = source::data_dir(opts.data.as_deref());
+    let models_key = if opts.quick { "quick.models" } else { "models" };
+    for (i, model) in work.models.iter().enumerate() {
+        check_model(spec, &format!("{models_key}[{i}]"), model, data.as_deref())?;
+    }
+    let methods = spec.methods.iter().map(|m| order::resolve(m, spec.seed)).collect::<Result<Vec<_>>>()?;
+    let raster = raster::backend(&spec.backend)?;
+    let measure = MeasureOptions { caches: work.caches.clone(), views: work.views, res: work.res, seed: spec.seed };
+    let context = Context {
+        experiment: spec.id.clone(),
+        seed: spec.seed,
+        backend: spec.backend.clone(),
+        machine: provenance::machine(),
+        commit: provenance::commit(),
+    };
+
+    let bar = bars.add(ProgressBar::new((work.models.len() * methods.len()) as u64));
+    bar.set_style(style("{prefix} {pos}/{len} {bar:30} {elapsed} {wide_msg}"));
+    bar.set_prefix(spec.id.clone());
+    let mut rows: Vec<Row> = Vec::new();
+    for model in &work.models {
+        bar.set_message(format!("{model}: loading"));
+        let mesh = source::open(model, data.as_deref(), spec.seed)?;
+        let topology = Topology::new(&mesh);
+        for warning in MeshReport::new(&mesh, &topology).warnings() {
+            bars.suspend(|| eprintln!("{model}: note: {warning}"));
+        }
+        for method in &methods {
+            bar.set_message(format!("{model} · {}", method.canonical()));
+            let evaluation = evaluate(&mesh, &topology, method, &measure, raster.as_ref())?;
+            rows.extend(context.rows(model, &mesh, method.method.name, &evaluation));
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    bars.remove(&bar);
+
+    let path = spec.csv_path(&opts.out_dir, opts.quick);
+    write_csv(&path, &rows)?;
+    Ok(path)
+}
+
+/// Fails before any work if `model` cannot be opened: a bad procedural spec, or a file that is
+/// neither where the spec says nor in the data directory.
+fn check_model(spec: &Spec, key: &str, model: &str, data: Option<&Path>) -> Result<()> {
+    if let Some(generated) = procedural::generate(model, spec.seed) {
+        return generated.map(drop).map_err(|e| Error::spec(&spec.path, format!("{key}: {e}")));
+    }
+    if Path::new(model).exists() || data.is_some_and(|d| d.join(model).exists()) {
+        return Ok(());
+    }
+    let looked = match data {
+        Some(dir) => format!("not found here or in the data directory {}", dir.display()),
+        None => "not found, and there is no data directory".to_string(),
+    };
+    Err(Error::spec(
+        &spec.path,
+        format!(
+            "{key} `{model}`: {looked}; give --data DIR or set TRIORDER_DATA to the directory holding models/, or run scripts/fetch-data.sh to download the models"
+        ),
+    ))
+}
+
+/// Writes `rows` as CSV to `path` atomically, creating its directory.
+fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output(path, e))?;
+    }
+    atomic::write_with(path, |out| {
+        let mut writer = csv::Writer::from_writer(out);
+        for row in rows {
+            writer.serialize(row).map_err(std::io::Error::other)?;
+        }
+        writer.flush()
+    })
+}
+
+/// A progress-bar group on stderr, or a hidden one.
+fn bars(progress: bool) -> MultiProgress {
+    MultiProgress::with_draw_target(if progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() })
+}
+
+fn style(template: &str) -> ProgressStyle {
+    ProgressStyle::with_template(template).expect("progress templates are valid")
+}

@@ -1,0 +1,563 @@
+//! Experiment specs: one TOML file per paper figure under `experiments/`.
+//!
+//! A spec says what to measure (models × methods × cache models × view set) and how to draw it,
+//! so that `triorder run` and `triorder plot` need nothing else and a figure can be reproduced
+//! from its file alone. Everything is checked when the spec is loaded (unknown keys, unknown
+//! methods or parameters, bad cache models, ranges or view sets, figure columns that the CSV
+//! will not have), before any mesh is loaded or ordered, and every error names the file and the
+//! key.
+//!
+//! ```toml
+//! id = "acmr-vs-fifo"              # file names: results/ID.csv, paper-figures/ID.svg; must equal
+//!                                  # the spec's file name without .toml
+//! title = "ACMR vs FIFO size"      # the figure's title
+//! question = "How many vertices…"  # what the figure answers (one sentence)
+//! claim = "Typical optimized…"     # optional: the paper's claim, with its source; drawn as a
+//!                                  # caption under the title
+//! models = ["models/bunny_2k.ply", "sphere:20480"]
+//!                                  # paths (tried as given, then in the data directory: --data,
+//!                                  # TRIORDER_DATA, ../shared/data) or procedural specs
+//! methods = "all"                  # every registered method with its defaults, or a list of
+//!                                  # method specs; any parameter may be a grid:
+//!                                  # ["input", "meshopt-fifo:cache={8,16,32}", "random:seed={1..3}"]
+//! caches = ["fifo:4..64", "lru:16", "batch:32,32,32"]
+//!                                  # cache models; `KIND:LO..HI` is every size from LO to HI
+//!                                  # inclusive, `KIND:LO..HI/STEP` every STEP-th (fifo, lru)
+//! views = "ico:162"                # optional: measure overdraw over this view set (axis6,
+//!                                  # ico:N, random:N)
+//! res = 512                        # optional, with views only: image size R×R (default 512)
+//! seed = 0                         # optional (default 0): seeds random orders, random views, disk:N
+//! backend = "cpu"                  # optional (default cpu): the raster backend
+//!
+//! [figure]
+//! kind = "line"                    # line | scatter | bar | distribution
+//! metric = "acmr"                  # the y values: rows whose `metric` column is this
+//!                                  # (acmr, atvr, seconds, ovr, ovr_mean, ovr_max, ovr_min,
+//!                                  # ovr_var, ovr_sum, ovr_empty)
+//! x = "cache_size"                 # CSV column on x (line, scatter: numeric; bar: categories;
+//!                                  # distribution: not allowed, it sorts the values itself)
+//! series = "method"                # optional (default method): one colour per value
+//! facet = "model"                  # optional: one small chart per value, all in one SVG
+//! filter = { cache_kind = "fifo" } # optional: keep only rows whose columns equal these values
+//! x_label = "FIFO size"            # optional axis labels (defaults name the column or metric)
+//! y_label = "ACMR"
+//! x_log = false                    # optional log axes (default false)
+//! y_log = false
+//! y_range = [0.5, 3.2]             # optional y axis range (default: fits the data)
+//!
+//! [quick]                          # what `--quick` runs: procedural models and assets/ only,
+//! models = ["assets/spot.obj"]     # done in seconds; caches, views and res override the
+//! caches = ["fifo:4..64/4"]        # full run's when given
+//! views = "ico:42"
+//! res = 128
+//! ```
+//!
+//! Grids (`{…}`) may appear anywhere in a method or cache spec; each item is a literal or an
+//! integer range `LO..HI[/STEP]` (inclusive), and several grids in one spec give their cartesian
+//! product. Specs that resolve to the same canonical method are run once.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::row::{COLUMNS, METRICS, Needs};
+use crate::error::{Error, Result};
+use crate::mesh::procedural;
+use crate::metrics::CacheModel;
+use crate::order::{self, METHODS};
+use crate::raster::{self, ViewSet};
+
+/// Overdraw image size when a spec gives views but no `res` (Nehab et al. 2006 use 512×512).
+pub const DEFAULT_RES: u32 = 512;
+
+/// Largest image side a spec may ask for: beyond it one depth buffer alone needs gigabytes.
+const MAX_RES: u32 = 16384;
+
+/// Most values one range or grid may produce: a typo like `fifo:4..4000000` is an error, not an
+/// hour-long run.
+const MAX_EXPANSION: usize = 10_000;
+
+/// A checked experiment spec.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spec {
+    /// The file it was loaded from (errors name it).
+    pub path: PathBuf,
+    pub id: String,
+    pub title: String,
+    pub question: String,
+    pub claim: Option<String>,
+    pub seed: u64,
+    pub backend: String,
+    /// Canonical method specs (every parameter written out), grids expanded, duplicates
+    /// removed, in the order the spec lists them.
+    pub methods: Vec<String>,
+    /// What a full run measures.
+    pub full: Workload,
+    /// What `--quick` measures, if the spec has a `[quick]` table.
+    pub quick: Option<Workload>,
+    pub figure: Figure,
+}
+
+/// The models and measurements of one run (full or quick).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Workload {
+    pub models: Vec<String>,
+    pub caches: Vec<CacheModel>,
+    pub views: Option<ViewSet>,
+    pub res: u32,
+}
+
+/// How the figure is drawn from the CSV.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    pub kind: FigureKind,
+    pub metric: String,
+    pub x: Option<String>,
+    pub series: String,
+    pub facet: Option<String>,
+    /// `(column, value)` pairs a row must match to be drawn.
+    pub filter: Vec<(String, String)>,
+    pub x_label: Option<String>,
+    pub y_label: Option<String>,
+    pub x_log: bool,
+    pub y_log: bool,
+    pub y_range: Option<(f64, f64)>,
+}
+
+/// The chart kinds `triorder plot` draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FigureKind {
+    /// y against a numeric x, one line per series (e.g. ACMR against cache size).
+    Line,
+    /// y against a numeric x, one point per row (e.g. ACMR against ordering time).
+    Scatter,
+    /// Grouped bars: categories on x, one bar per series in each group.
+    Bar,
+    /// Every value of each series sorted ascending (a quantile curve) with its mean dashed, and
+    /// mean, max and variance written in the chart: for per-view overdraw.
+    Distribution,
+}
+
+impl Spec {
+    /// Reads and checks the spec at `path`.
+    pub fn load(path: &Path) -> Result<Spec> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::spec(path, format!("cannot read: {e}")))?;
+        let raw: RawSpec = toml::from_str(&text).map_err(|e| Error::spec(path, e.to_string().trim_end()))?;
+        raw.check(path)
+    }
+
+    /// What a run measures: the `[quick]` table's workload when `quick`.
+    pub fn workload(&self, quick: bool) -> Result<&Workload> {
+        match (quick, &self.quick) {
+            (false, _) => Ok(&self.full),
+            (true, Some(quick)) => Ok(quick),
+            (true, None) => Err(Error::spec(&self.path, "has no [quick] table, so it cannot run with --quick")),
+        }
+    }
+
+    /// `ROOT/results/ID.csv`, or `ROOT/results/quick/ID.csv` for quick runs.
+    pub fn csv_path(&self, root: &Path, quick: bool) -> PathBuf {
+        output_dir(root, "results", quick).join(format!("{}.csv", self.id))
+    }
+
+    /// `ROOT/paper-figures/ID.svg`, or `ROOT/paper-figures/quick/ID.svg` for quick runs.
+    pub fn svg_path(&self, root: &Path, quick: bool) -> PathBuf {
+        output_dir(root, "paper-figures", quick).join(format!("{}.svg", self.id))
+    }
+}
+
+fn output_dir(root: &Path, kind: &str, quick: bool) -> PathBuf {
+    let dir = root.join(kind);
+    if quick { dir.join("quick") } else { dir }
+}
+
+/// The spec as written; [`RawSpec::check`] turns it into a [`Spec`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSpec {
+    id: String,
+    title: String,
+    question: String,
+    claim: Option<String>,
+    models: Vec<String>,
+    methods: RawMethods,
+    #[serde(default)]
+    caches: Vec<String>,
+    views: Option<String>,
+    res: Option<u32>,
+    #[serde(default)]
+    seed: u64,
+    backend: Option<String>,
+    figure: RawFigure,
+    quick: Option<RawQuick>,
+}
+
+/// `methods = "all"` or a list of method specs.
+enum RawMethods {
+    Word(String),
+    List(Vec<String>),
+}
+
+/// By hand rather than `#[serde(untagged)]`, so a wrong type says what is expected instead of
+/// "did not match any variant".
+impl<'de> Deserialize<'de> for RawMethods {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
+        struct Expect;
+        impl<'de> serde::de::Visitor<'de> for Expect {
+            type Value = RawMethods;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"all\" or a list of method specs")
+            }
+            fn visit_str<E: serde::de::Error>(self, word: &str) -> std::result::Result<RawMethods, E> {
+                Ok(RawMethods::Word(word.to_string()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<RawMethods, A::Error> {
+                let mut list = Vec::new();
+                while let Some(spec) = seq.next_element::<String>()? {
+                    list.push(spec);
+                }
+                Ok(RawMethods::List(list))
+            }
+        }
+        deserializer.deserialize_any(Expect)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFigure {
+    kind: FigureKind,
+    metric: String,
+    x: Option<String>,
+    series: Option<String>,
+    facet: Option<String>,
+    #[serde(default)]
+    filter: toml::Table,
+    x_label: Option<String>,
+    y_label: Option<String>,
+    #[serde(default)]
+    x_log: bool,
+    #[serde(default)]
+    y_log: bool,
+    y_range: Option<[f64; 2]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawQuick {
+    models: Vec<String>,
+    caches: Option<Vec<String>>,
+    views: Option<String>,
+    res: Option<u32>,
+}
+
+impl RawSpec {
+    fn check(self, path: &Path) -> Result<Spec> {
+        let err = |problem: String| Error::spec(path, problem);
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        if self.id.is_empty() || !self.id.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+            return Err(err(format!("id `{}` must be non-empty letters, digits, `-` or `_`", self.id)));
+        }
+        if self.id != stem {
+            return Err(err(format!(
+                "id `{}` must equal the file name `{stem}` (so results/{stem}.csv is this spec's)",
+                self.id
+            )));
+        }
+        for (key, text) in [("title", &self.title), ("question", &self.question)] {
+            if text.trim().is_empty() {
+                return Err(err(format!("{key} is empty")));
+            }
+        }
+        let methods = check_methods(&self.methods, self.seed).map_err(err)?;
+        let backend = self.backend.unwrap_or_else(|| "cpu".into());
+        raster::backend(&backend).map_err(|e| err(format!("backend: {e}")))?;
+
+        let full = check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res).map_err(err)?;
+        let quick = match &self.quick {
+            None => None,
+            Some(q) => {
+                let caches = q.caches.as_ref().unwrap_or(&self.caches);
+                let views = q.views.as_deref().or(self.views.as_deref());
+                let res = q.res.or(self.res);
+                let work = check_workload("quick.", &q.models, caches, views, res).map_err(err)?;
+                if let Some((i, model)) = work.models.iter().enumerate().find(|(_, m)| !is_bundled(m)) {
+                    return Err(err(format!(
+                        "quick.models[{i}] `{model}`: quick runs use procedural models and files under assets/ only, so they work on a fresh clone"
+                    )));
+                }
+                Some(work)
+            }
+        };
+        let figure = self.figure.check(&full).map_err(err)?;
+        Ok(Spec {
+            path: path.to_path_buf(),
+            id: self.id,
+            title: self.title,
+            question: self.question,
+            claim: self.claim.filter(|c| !c.trim().is_empty()),
+            seed: self.seed,
+            backend,
+            methods,
+            full,
+            quick,
+            figure,
+        })
+    }
+}
+
+/// True for models a fresh clone has: procedural specs and the bundled `assets/` files.
+fn is_bundled(model: &str) -> bool {
+    model.starts_with("assets/") || procedural::generate(model, 0).is_some()
+}
+
+/// Expands and resolves the method list; the canonical specs, deduplicated, in order.
+fn check_methods(methods: &RawMethods, seed: u64) -> std::result::Result<Vec<String>, String> {
+    let written: Vec<(String, String)> = match methods {
+        RawMethods::Word(w) if w == "all" => {
+            METHODS.iter().map(|m| ("methods".to_string(), m.name.to_string())).collect()
+        }
+        RawMethods::Word(w) => {
+            return Err(format!("methods = \"{w}\": expected \"all\" or a list of method specs"));
+        }
+        RawMethods::List(list) if list.is_empty() => return Err("methods is an empty list".into()),
+        RawMethods::List(list) => {
+            let mut out = Vec::new();
+            for (i, text) in list.iter().enumerate() {
+                let key = format!("methods[{i}]");
+                let specs = expand_grid(text).map_err(|why| format!("{key} `{text}` {why}"))?;
+                out.extend(specs.into_iter().map(|s| (key.clone(), s)));
+            }
+            out
+        }
+    };
+    let mut seen = HashSet::new();
+    let mut canonical = Vec::new();
+    for (key, text) in written {
+        let resolved = order::resolve(&text, seed).map_err(|e| format!("{key} `{text}`: {e}"))?;
+        let name = resolved.canonical();
+        if seen.insert(name.clone()) {
+            canonical.push(name);
+        }
+    }
+    Ok(canonical)
+}
+
+/// Checks one run's models, caches, views and res; `prefix` is `quick.` for the `[quick]` table
+/// (whose missing keys the caller has already filled from the full run's).
+fn check_workload(
+    prefix: &str,
+    models: &[String],
+    caches: &[String],
+    views: Option<&str>,
+    res: Option<u32>,
+) -> std::result::Result<Workload, String> {
+    if models.is_empty() {
+        return Err(format!("{prefix}models is empty"));
+    }
+    if let Some((i, _)) = models.iter().enumerate().find(|(_, m)| m.trim().is_empty()) {
+        return Err(format!("{prefix}models[{i}] is empty"));
+    }
+    let mut parsed = Vec::new();
+    for (i, text) in caches.iter().enumerate() {
+        let key = format!("{prefix}caches[{i}]");
+        for model in expand_cache(text).map_err(|why| format!("{key} `{text}` {why}"))? {
+            let model: CacheModel = model.parse().map_err(|e| format!("{key}: {e}"))?;
+            if !parsed.contains(&model) {
+                parsed.push(model);
+            }
+        }
+    }
+    let views = views.map(|v| v.parse::<ViewSet>().map_err(|e| format!("{prefix}views: {e}"))).transpose()?;
+    let res = match (views, res) {
+        (None, Some(_)) => {
+            return Err(format!("{prefix}res is set but views is not (res is the overdraw image size)"));
+        }
+        (_, Some(r)) if !(1..=MAX_RES).contains(&r) => {
+            return Err(format!("{prefix}res = {r} is not in 1..={MAX_RES}"));
+        }
+        (_, Some(r)) => r,
+        (_, None) => DEFAULT_RES,
+    };
+    if parsed.is_empty() && views.is_none() {
+        return Err(format!("{prefix}caches is empty and views is not set: nothing to measure but time"));
+    }
+    Ok(Workload { models: models.to_vec(), caches: parsed, views, res })
+}
+
+impl RawFigure {
+    fn check(self, full: &Workload) -> std::result::Result<Figure, String> {
+        let metric = METRICS.iter().find(|m| m.name == self.metric).ok_or_else(|| {
+            let known: Vec<_> = METRICS.iter().map(|m| m.name).collect();
+            format!("figure.metric `{}` is not a metric the CSV has (metrics: {})", self.metric, known.join(", "))
+        })?;
+        match metric.needs {
+            Needs::Caches if full.caches.is_empty() => {
+                return Err(format!("figure.metric = \"{}\" needs `caches`", metric.name));
+            }
+            Needs::Views if full.views.is_none() => {
+                return Err(format!("figure.metric = \"{}\" needs `views`", metric.name));
+            }
+            _ => {}
+        }
+        let column = |key: &str, name: &str| {
+            if COLUMNS.contains(&name) {
+                Ok(())
+            } else {
+                Err(format!("{key} `{name}` is not a CSV column (columns: {})", COLUMNS.join(", ")))
+            }
+        };
+        match (self.kind, &self.x) {
+            (FigureKind::Distribution, Some(_)) => {
+                return Err(
+                    "figure.x is not used by kind = \"distribution\" (it sorts the values itself): remove it".into()
+                );
+            }
+            (FigureKind::Distribution, None) => {}
+            (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
+            (_, Some(x)) => column("figure.x", x)?,
+        }
+        if self.x_log && matches!(self.kind, FigureKind::Bar | FigureKind::Distribution) {
+            return Err(format!("figure.x_log: kind = \"{}\" has no numeric x axis", kind_name(self.kind)));
+        }
+        let series = self.series.unwrap_or_else(|| "method".into());
+        column("figure.series", &series)?;
+        if let Some(facet) = &self.facet {
+            column("figure.facet", facet)?;
+        }
+        let mut filter = Vec::new();
+        for (key, value) in self.filter {
+            column("figure.filter key", &key)?;
+            let value = match value {
+                toml::Value::String(s) => s,
+                toml::Value::Integer(i) => i.to_string(),
+                toml::Value::Boolean(b) => b.to_string(),
+                other => return Err(format!("figure.filter.{key} = {other}: expected a string, integer or boolean")),
+            };
+            filter.push((key, value));
+        }
+        let y_range = match self.y_range {
+            Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
+                return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
+            }
+            Some([lo, _]) if self.y_log && lo <= 0.0 => {
+                return Err(format!("figure.y_range starts at {lo}, but a log axis needs values > 0"));
+            }
+            r => r.map(|[lo, hi]| (lo, hi)),
+        };
+        Ok(Figure {
+            kind: self.kind,
+            metric: self.metric,
+            x: self.x,
+            series,
+            facet: self.facet,
+            filter,
+            x_label: self.x_label,
+            y_label: self.y_label,
+            x_log: self.x_log,
+            y_log: self.y_log,
+            y_range,
+        })
+    }
+}
+
+fn kind_name(kind: FigureKind) -> &'static str {
+    match kind {
+        FigureKind::Line => "line",
+        FigureKind::Scatter => "scatter",
+        FigureKind::Bar => "bar",
+        FigureKind::Distribution => "distribution",
+    }
+}
+
+/// Expands a cache spec: `KIND:LO..HI[/STEP]` is shorthand for `KIND:{LO..HI[/STEP]}`; any
+/// other `{…}` grid expands as in method specs.
+fn expand_cache(text: &str) -> std::result::Result<Vec<String>, String> {
+    let text = text.trim();
+    match text.split_once(':') {
+        Some((kind, args)) if !text.contains('{') && args.contains("..") => {
+            if args.contains(',') {
+                return Err(
+                    "puts a range in a multi-size cache model: write the grid in braces, e.g. batch:{16..32/16},32,32"
+                        .into(),
+                );
+            }
+            expand_grid(&format!("{kind}:{{{args}}}"))
+        }
+        _ => expand_grid(text),
+    }
+}
+
+/// Expands every `{…}` group of `text` into the cartesian product of its items, left to right.
+/// An item is a literal (`16`, `0.85`, `hoppe`) or an inclusive integer range `LO..HI[/STEP]`.
+pub fn expand_grid(text: &str) -> std::result::Result<Vec<String>, String> {
+    let Some(open) = text.find('{') else {
+        return if text.contains('}') { Err("has a `}` without `{`".into()) } else { Ok(vec![text.to_string()]) };
+    };
+    let prefix = &text[..open];
+    if prefix.contains('}') {
+        return Err("has a `}` without `{`".into());
+    }
+    let close = text[open..].find('}').map(|i| open + i).ok_or("has a `{` without `}`")?;
+    let inner = &text[open + 1..close];
+    if inner.contains('{') {
+        return Err("nests `{` inside `{…}`".into());
+    }
+    let mut items = Vec::new();
+    for item in inner.split(',').map(str::trim) {
+        if item.is_empty() {
+            return Err(format!("has an empty item in `{{{inner}}}`"));
+        }
+        match item.split_once("..") {
+            Some((lo, hi)) => items.extend(integer_range(lo, hi)?.into_iter().map(|v| v.to_string())),
+            None => items.push(item.to_string()),
+        }
+    }
+    let rest = expand_grid(&text[close + 1..])?;
+    if items.len() * rest.len() > MAX_EXPANSION {
+        return Err(format!("expands to {} specs (at most {MAX_EXPANSION})", items.len() * rest.len()));
+    }
+    Ok(items.iter().flat_map(|item| rest.iter().map(move |r| format!("{prefix}{item}{r}"))).collect())
+}
+
+/// `LO..HI` or `LO..HI/STEP` (the text after `..` is `hi`): LO, LO+STEP, … up to HI inclusive.
+fn integer_range(lo: &str, hi: &str) -> std::result::Result<Vec<i64>, String> {
+    let (hi, step) = hi.split_once('/').unwrap_or((hi, "1"));
+    let int = |s: &str, what: &str| {
+        s.trim().parse::<i64>().map_err(|_| format!("has a range {what} `{}` that is not an integer", s.trim()))
+    };
+    let (lo, hi, step) = (int(lo, "start")?, int(hi, "end")?, int(step, "step")?);
+    if step < 1 {
+        return Err(format!("has a range step {step} (must be ≥ 1)"));
+    }
+    if lo > hi {
+        return Err(format!("has an empty range {lo}..{hi} (start after end)"));
+    }
+    let count = (hi - lo) / step + 1;
+    if count > MAX_EXPANSION as i64 {
+        return Err(format!("has a range of {count} values (at most {MAX_EXPANSION})"));
+    }
+    Ok((0..count).map(|i| lo + i * step).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grids_and_ranges_expand() {
+        assert_eq!(expand_grid("m:cache={8,16}").unwrap(), ["m:cache=8", "m:cache=16"]);
+        assert_eq!(expand_grid("m:a={1..3},b={x,y}").unwrap().len(), 6);
+        assert_eq!(expand_grid("m:a={1..3},b={x,y}").unwrap()[1], "m:a=1,b=y");
+        assert_eq!(expand_cache("fifo:4..16/4").unwrap(), ["fifo:4", "fifo:8", "fifo:12", "fifo:16"]);
+        assert_eq!(expand_cache("fifo:4..5").unwrap(), ["fifo:4", "fifo:5"]);
+        assert_eq!(expand_cache("batch:{16,32},32,32").unwrap(), ["batch:16,32,32", "batch:32,32,32"]);
+        assert_eq!(expand_cache("lru:16").unwrap(), ["lru:16"]);
+        for bad in ["m:{1,2", "m:1}", "m:{}", "m:{{1}}", "m:{1..x}", "m:{5..1}", "m:{1..9/0}", "m:{0..99999}"] {
+            assert!(expand_grid(bad).is_err(), "{bad}");
+        }
+        assert!(expand_cache("batch:16..32,32,32").is_err());
+    }
+}

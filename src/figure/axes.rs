@@ -1,0 +1,325 @@
+//! What every chart kind shares: the panel frame (axes, linear or log, with the same ranges in
+//! every panel so small multiples compare at a glance), series colours, the legend strip and
+//! number formatting.
+
+use std::ops::Range;
+
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{Ranged, ValueFormatter};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::order::METHODS;
+
+pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+pub type DrawResult = std::result::Result<(), DrawingAreaErrorKind<std::io::Error>>;
+
+/// The font family of every text: plain SVG text, rendered by the viewer's sans-serif font.
+pub const FONT: &str = "sans-serif";
+
+/// Axes shared by every panel of a figure.
+pub struct Frame {
+    pub x: Range<f64>,
+    pub y: Range<f64>,
+    pub x_log: bool,
+    pub y_log: bool,
+    pub x_desc: String,
+    pub y_desc: String,
+    /// Category names at x = 0, 1, 2, … (bar charts): the x axis shows them instead of numbers.
+    pub categories: Option<Vec<String>>,
+}
+
+/// Draws one panel's data into its chart, whatever the axes' scales.
+pub trait Painter {
+    fn paint<'a, 'b: 'a, X, Y>(&self, chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>) -> DrawResult
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>;
+}
+
+/// Draws a panel titled `title` with `frame`'s axes into `area`, then `painter`'s data.
+pub fn panel(area: &Area, title: &str, frame: &Frame, painter: &impl Painter) -> DrawResult {
+    let mut builder = ChartBuilder::on(area);
+    builder.margin(10).margin_right(20).x_label_area_size(48).y_label_area_size(72);
+    if !title.is_empty() {
+        builder.caption(title, (FONT, 15));
+    }
+    let (x, y) = (frame.x.clone(), frame.y.clone());
+    let log = |r: Range<f64>| {
+        let ticks = log_ticks(r.start, r.end);
+        r.log_scale().with_key_points(ticks)
+    };
+    match (frame.x_log, frame.y_log) {
+        (false, false) => finish(builder.build_cartesian_2d(x, y)?, frame, painter),
+        (true, false) => finish(builder.build_cartesian_2d(log(x), y)?, frame, painter),
+        (false, true) => finish(builder.build_cartesian_2d(x, log(y))?, frame, painter),
+        (true, true) => finish(builder.build_cartesian_2d(log(x), log(y))?, frame, painter),
+    }
+}
+
+/// Tick values for a log axis over `lo..hi` (both > 0): m·10^k for the sparsest set of
+/// mantissas whose tick count is nearest seven, or evenly spaced round values when the range is
+/// too narrow for any to give four. plotters' own log ticks are powers of the base only, which leaves a
+/// range like 0.5..3 labelled at 1, 2, 3 and nowhere below 1.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    const MANTISSAS: [&[f64]; 4] =
+        [&[1.0], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]];
+    let at = |m: f64, k: i32| if k < 0 { m / 10f64.powi(-k) } else { m * 10f64.powi(k) };
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let ticks = |mantissas: &[f64]| -> Vec<f64> {
+        (first..=last)
+            .flat_map(|k| mantissas.iter().map(move |&m| at(m, k)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let best = MANTISSAS.iter().map(|m| ticks(m)).min_by_key(|t| t.len().abs_diff(7)).unwrap_or_default();
+    if best.len() >= 4 {
+        return best;
+    }
+    let raw = (hi - lo) / 5.0;
+    let magnitude = raw.log10().floor() as i32;
+    let step = [1.0, 2.0, 5.0, 10.0].iter().map(|&m| at(m, magnitude)).find(|&s| s >= raw).unwrap_or(raw);
+    let start = (lo / step).ceil() as i64;
+    (start..).map(|i| i as f64 * step).take_while(|&v| v <= hi).collect()
+}
+
+fn finish<'a, 'b: 'a, X, Y>(
+    mut chart: ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    frame: &Frame,
+    painter: &impl Painter,
+) -> DrawResult
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let category = |v: &f64| {
+        let i = v.round();
+        match &frame.categories {
+            Some(names) if (v - i).abs() < 1e-6 && i >= 0.0 => names.get(i as usize).cloned().unwrap_or_default(),
+            _ => String::new(),
+        }
+    };
+    let value = |v: &f64| number(*v);
+    let mut mesh = chart.configure_mesh();
+    mesh.x_label_formatter(&value)
+        .y_label_formatter(&value)
+        .x_desc(frame.x_desc.as_str())
+        .y_desc(frame.y_desc.as_str())
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(BLACK.mix(0.04));
+    if let Some(names) = &frame.categories {
+        mesh.x_labels(names.len()).x_label_formatter(&category).disable_x_mesh();
+    }
+    mesh.draw()?;
+    painter.paint(&mut chart)
+}
+
+/// Colours chosen so that a series keeps its colour from figure to figure: methods by their
+/// place in the registry ([`METHODS`], so `input` is always grey and `random` red), variants of
+/// one method (a parameter grid) in lighter and darker shades of it, anything else by a hash of
+/// its name; two different series of one figure never share a base colour while the palette
+/// lasts.
+pub struct Colors(Vec<(String, RGBColor)>);
+
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(0x4d, 0x4d, 0x4d), // grey
+    RGBColor(0xe1, 0x57, 0x59), // red
+    RGBColor(0x4e, 0x79, 0xa7), // blue
+    RGBColor(0xf2, 0x8e, 0x2b), // orange
+    RGBColor(0x59, 0xa1, 0x4f), // green
+    RGBColor(0xb0, 0x7a, 0xa1), // purple
+    RGBColor(0x76, 0xb7, 0xb2), // teal
+    RGBColor(0x9c, 0x75, 0x5f), // brown
+    RGBColor(0xed, 0xc9, 0x48), // yellow
+    RGBColor(0xff, 0x9d, 0xa7), // pink
+];
+
+impl Colors {
+    /// Colours for the series `names` (in legend order) of the CSV column `column`.
+    pub fn new(column: &str, names: &[String]) -> Colors {
+        let methods = column == "method" || column == "method_name";
+        // The family a series belongs to, and that family's preferred palette slot.
+        let family = |name: &str| -> (String, usize) {
+            let method = name.split(':').next().unwrap_or(name);
+            match METHODS.iter().position(|m| methods && m.name == method) {
+                Some(i) => (method.to_string(), i % PALETTE.len()),
+                None => (name.to_string(), fnv1a(name) % PALETTE.len()),
+            }
+        };
+        let mut slots: Vec<(String, usize)> = Vec::new();
+        for name in names {
+            let (key, mut slot) = family(name);
+            if slots.iter().any(|(k, _)| *k == key) {
+                continue;
+            }
+            while slots.len() < PALETTE.len() && slots.iter().any(|&(_, s)| s == slot) {
+                slot = (slot + 1) % PALETTE.len();
+            }
+            slots.push((key, slot));
+        }
+        let colors = names
+            .iter()
+            .map(|name| {
+                let key = family(name).0;
+                let slot = slots.iter().find(|(k, _)| *k == key).map_or(0, |&(_, s)| s);
+                let variants: Vec<&String> = names.iter().filter(|n| family(n).0 == key).collect();
+                let k = variants.iter().position(|n| *n == name).unwrap_or(0);
+                (name.clone(), shade(PALETTE[slot], k, variants.len()))
+            })
+            .collect();
+        Colors(colors)
+    }
+
+    pub fn of(&self, name: &str) -> RGBColor {
+        self.0.iter().find(|(n, _)| n == name).map_or(BLACK, |&(_, c)| c)
+    }
+
+    pub fn entries(&self) -> &[(String, RGBColor)] {
+        &self.0
+    }
+}
+
+/// Variant `k` of `n` of a colour: from 45% darker to 45% lighter.
+fn shade(color: RGBColor, k: usize, n: usize) -> RGBColor {
+    if n <= 1 {
+        return color;
+    }
+    let t = k as f64 / (n - 1) as f64 * 0.9 - 0.45;
+    let channel = |c: u8| {
+        let c = f64::from(c);
+        (if t < 0.0 { c * (1.0 + t) } else { c + (255.0 - c) * t }).round() as u8
+    };
+    RGBColor(channel(color.0), channel(color.1), channel(color.2))
+}
+
+/// FNV-1a: a hash that, unlike std's, is the same in every build and on every machine.
+fn fnv1a(text: &str) -> usize {
+    let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+    (hash % (1 << 31)) as usize
+}
+
+/// How the legend shows a series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Swatch {
+    Line,
+    Point,
+    Block,
+}
+
+const LEGEND_ROW: i32 = 22;
+const LEGEND_FONT: f64 = 13.0;
+
+/// Rough width of `text` in pixels at `size` (SVG has no font metrics; sans-serif averages ~0.55 em).
+pub fn text_width(text: &str, size: f64) -> i32 {
+    (text.chars().count() as f64 * size * 0.55).ceil() as i32
+}
+
+/// Where each legend entry goes in a strip `width` wide: `(x, row)`, entries flowing left to
+/// right and wrapping.
+fn legend_layout(entries: &[(String, RGBColor)], width: i32) -> Vec<(i32, i32)> {
+    let (mut x, mut row) = (20, 0);
+    entries
+        .iter()
+        .map(|(label, _)| {
+            let w = 34 + text_width(label, LEGEND_FONT) + 24;
+            if x > 20 && x + w > width - 20 {
+                x = 20;
+                row += 1;
+            }
+            let at = (x, row);
+            x += w;
+            at
+        })
+        .collect()
+}
+
+/// Height of the legend strip for `entries` in `width` pixels.
+pub fn legend_height(entries: &[(String, RGBColor)], width: u32) -> u32 {
+    let rows = legend_layout(entries, width as i32).last().map_or(0, |&(_, r)| r + 1);
+    (rows * LEGEND_ROW + 12) as u32
+}
+
+/// Draws the legend strip: a swatch and the series name per entry.
+pub fn legend(area: &Area, entries: &[(String, RGBColor)], swatch: Swatch) -> DrawResult {
+    let width = area.dim_in_pixel().0 as i32;
+    let style = TextStyle::from((FONT, LEGEND_FONT)).pos(Pos::new(HPos::Left, VPos::Center));
+    for ((label, color), (x, row)) in entries.iter().zip(legend_layout(entries, width)) {
+        let y = 6 + row * LEGEND_ROW + LEGEND_ROW / 2;
+        match swatch {
+            Swatch::Line => area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], color.stroke_width(3)))?,
+            Swatch::Point => area.draw(&Circle::new((x + 13, y), 5, color.filled()))?,
+            Swatch::Block => area.draw(&Rectangle::new([(x + 4, y - 7), (x + 22, y + 7)], color.filled()))?,
+        }
+        area.draw(&Text::new(label.clone(), (x + 34, y), style.clone()))?;
+    }
+    Ok(())
+}
+
+/// A value with about four significant digits and no trailing zeros: `0.6512`, `1.25`, `3`,
+/// and `2.5e-5` for very small or large magnitudes.
+pub fn number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return v.to_string();
+    }
+    if !(1e-3..1e6).contains(&v.abs()) {
+        let text = format!("{v:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        return format!("{}e{exponent}", mantissa.trim_end_matches('0').trim_end_matches('.'));
+    }
+    let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 8) as usize;
+    let text = format!("{v:.decimals$}");
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
+}
+
+/// Splits `text` into lines of at most `max` characters at spaces.
+pub fn wrap(text: &str, max: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split_whitespace() {
+        match lines.last_mut() {
+            Some(line) if line.chars().count() + 1 + word.chars().count() <= max => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_and_wrapping() {
+        assert_eq!(number(0.651234), "0.6512");
+        assert_eq!(number(1.25), "1.25");
+        assert_eq!(number(3.0), "3");
+        assert_eq!(number(1234.6), "1235");
+        assert_eq!(number(0.000123456), "1.235e-4");
+        assert_eq!(number(0.00002), "2e-5");
+        assert_eq!(number(0.0012), "0.0012");
+        assert_eq!(wrap("a bb ccc dddd", 6), ["a bb", "ccc", "dddd"]);
+        assert_eq!(log_ticks(0.45, 3.3), [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 2.0, 3.0]);
+        assert_eq!(log_ticks(0.9, 120.0), [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0]);
+        assert_eq!(log_ticks(1e-6, 2e-3), [1e-6, 1e-5, 1e-4, 1e-3]);
+        assert_eq!(log_ticks(1.01, 1.3).len(), 3); // 1.1, 1.2, 1.3 (round values, not decades)
+    }
+
+    #[test]
+    fn colours_are_stable_and_distinct() {
+        let names: Vec<String> =
+            ["input", "random:seed=0", "meshopt-fifo:cache=8", "meshopt-fifo:cache=16"].map(String::from).to_vec();
+        let colors = Colors::new("method", &names);
+        assert_eq!(colors.of("input"), PALETTE[0]);
+        assert_eq!(colors.of("random:seed=0"), PALETTE[1]);
+        assert_ne!(colors.of("meshopt-fifo:cache=8"), colors.of("meshopt-fifo:cache=16"));
+        // The same series in another figure, with other company, keeps its colour.
+        let alone = Colors::new("method", &["random:seed=0".to_string()]);
+        assert_eq!(alone.of("random:seed=0"), PALETTE[1]);
+        let models = Colors::new("model", &["a".to_string(), "b".to_string()]);
+        assert_ne!(models.of("a"), models.of("b"));
+    }
+}

@@ -1,0 +1,105 @@
+//! Distribution charts, for per-view overdraw: each series' values sorted ascending and drawn
+//! against their percentile (a quantile curve: the left end is the best view, the right end the
+//! worst, the slope the spread), the mean as a dashed line of the same colour, and mean, max and
+//! variance written in the panel, so the summary the papers report (Nehab et al. 2006 §6: mean,
+//! worst case, variance) sits beside the whole distribution it summarises.
+
+use plotters::coord::ranged1d::{Ranged, ValueFormatter};
+use plotters::prelude::*;
+
+use super::axes::{self, Area, Colors, DrawResult, FONT, Frame, Painter, Swatch};
+use super::data::Panel;
+use super::{Extent, Kind, XAxis};
+
+/// One series of one panel: its values sorted ascending, and their statistics.
+struct Sorted {
+    name: String,
+    values: Vec<f64>,
+    mean: f64,
+    max: f64,
+    /// Population variance, as the results' `ovr_var`.
+    variance: f64,
+}
+
+/// Sorted values per series per panel.
+pub struct Distribution {
+    panels: Vec<Vec<Sorted>>,
+}
+
+impl Distribution {
+    pub fn new(panels: &[Panel]) -> Distribution {
+        let panels = panels
+            .iter()
+            .map(|panel| {
+                panel
+                    .series
+                    .iter()
+                    .map(|series| {
+                        let mut values: Vec<f64> = series.points.iter().map(|&(_, y)| y).collect();
+                        values.sort_by(f64::total_cmp);
+                        let n = values.len().max(1) as f64;
+                        let mean = values.iter().sum::<f64>() / n;
+                        let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+                        let max = values.last().copied().unwrap_or(f64::NAN);
+                        Sorted { name: series.name.clone(), values, mean, max, variance }
+                    })
+                    .collect()
+            })
+            .collect();
+        Distribution { panels }
+    }
+}
+
+impl Kind for Distribution {
+    fn extent(&self) -> Extent {
+        let all = self.panels.iter().flatten().flat_map(|s| s.values.iter().copied());
+        Extent { x: XAxis::Fixed(0.0..100.0), y: super::span(all).unwrap_or((0.0, 1.0)), from_zero: false }
+    }
+
+    fn swatch(&self) -> Swatch {
+        Swatch::Line
+    }
+
+    fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult {
+        axes::panel(area, title, frame, &DistributionPainter { series: &self.panels[index], colors })
+    }
+}
+
+struct DistributionPainter<'a> {
+    series: &'a [Sorted],
+    colors: &'a Colors,
+}
+
+impl Painter for DistributionPainter<'_> {
+    fn paint<'a, 'b: 'a, X, Y>(&self, chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>) -> DrawResult
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        for s in self.series {
+            let color = self.colors.of(&s.name);
+            let n = s.values.len() as f64;
+            let curve = s.values.iter().enumerate().map(|(i, &v)| (100.0 * (i as f64 + 0.5) / n, v));
+            let stats = format!(
+                "{}: mean {}, max {}, variance {} (n = {})",
+                s.name,
+                axes::number(s.mean),
+                axes::number(s.max),
+                axes::number(s.variance),
+                s.values.len()
+            );
+            chart
+                .draw_series(LineSeries::new(curve, color.stroke_width(2)))?
+                .label(stats)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
+            chart.draw_series(DashedLineSeries::new([(0.0, s.mean), (100.0, s.mean)], 6, 4, color.stroke_width(1)))?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 12))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.3))
+            .draw()
+    }
+}

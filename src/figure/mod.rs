@@ -1,0 +1,245 @@
+//! Figures: a results CSV → one SVG, drawn as the spec's `[figure]` table says.
+//!
+//! A figure reads only the CSV (never recomputes), so it can be redrawn, restyled or reviewed
+//! without the models or the time to measure them. Layout: the title, the paper's claim as a
+//! caption under it, one panel per facet value (small multiples sharing their axes), and one
+//! legend strip for the whole figure with a colour per series that stays that series' colour in
+//! every figure ([`axes::Colors`]). The kinds differ only in how a panel's data is drawn:
+//! [`xy`] (line, scatter), [`bar`] and [`distribution`].
+
+mod axes;
+mod bar;
+mod data;
+mod distribution;
+mod xy;
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::error::{Error, Result};
+use crate::experiment::row::METRICS;
+use crate::experiment::spec::{Figure, FigureKind, Spec};
+use axes::{Area, Colors, DrawResult, FONT, Frame, Swatch};
+use data::{Panel, Table};
+
+/// Where to read results and write the figure.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PlotOptions {
+    /// Plot the quick run (`results/quick/` → `paper-figures/quick/`).
+    pub quick: bool,
+    /// The project root holding `results/` and `paper-figures/`.
+    pub out_dir: PathBuf,
+}
+
+impl Default for PlotOptions {
+    fn default() -> Self {
+        PlotOptions { quick: false, out_dir: PathBuf::from(".") }
+    }
+}
+
+/// Draws the figure of the spec at `spec` from its CSV; returns the SVG's path.
+pub fn plot(spec: &Path, opts: &PlotOptions) -> Result<PathBuf> {
+    plot_spec(&Spec::load(spec)?, opts)
+}
+
+/// Draws the figure of a loaded spec (see [`plot`]).
+pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
+    let csv = spec.csv_path(&opts.out_dir, opts.quick);
+    let table = Table::read(&csv)?;
+    let panels = table.select(&spec.figure)?;
+    let figure = &spec.figure;
+    let mut setup: Vec<String> = table
+        .distinct(&["views", "res"])
+        .iter()
+        .map(|v| format!("views {} at {}×{} pixels", v[0], v[1], v[1]))
+        .collect();
+    if opts.quick {
+        setup.push("quick run: small stand-in models, not the paper's".into());
+    }
+    let kind: Box<dyn Kind> = match figure.kind {
+        FigureKind::Line | FigureKind::Scatter => {
+            let x = figure.x.as_deref().unwrap_or_default();
+            Box::new(xy::Xy::new(&panels, x, figure.kind == FigureKind::Line, &csv)?)
+        }
+        FigureKind::Bar => Box::new(bar::Bars::new(&panels)),
+        FigureKind::Distribution => Box::new(distribution::Distribution::new(&panels)),
+    };
+    let frame = frame(kind.as_ref(), figure, &csv)?;
+    let mut names: Vec<String> = Vec::new();
+    for s in panels.iter().flat_map(|p| &p.series) {
+        if !names.contains(&s.name) {
+            names.push(s.name.clone());
+        }
+    }
+    let colors = Colors::new(&figure.series, &names);
+
+    let path = spec.svg_path(&opts.out_dir, opts.quick);
+    let mut svg = String::new();
+    draw(&mut svg, spec, &setup.join(" · "), &panels, kind.as_ref(), &frame, &colors)
+        .map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output(&path, e))?;
+    }
+    crate::atomic::write(&path, svg.as_bytes())?;
+    Ok(path)
+}
+
+/// A chart kind: its data, prepared from the panels, and how one panel of it is drawn.
+trait Kind {
+    /// The extent of the data over all panels (panels share axes).
+    fn extent(&self) -> Extent;
+    fn swatch(&self) -> Swatch;
+    /// Draws panel `index` into `area`.
+    fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult;
+}
+
+/// What the data spans.
+struct Extent {
+    x: XAxis,
+    /// Smallest and largest y.
+    y: (f64, f64),
+    /// Bars: a linear y axis starts at zero.
+    from_zero: bool,
+}
+
+enum XAxis {
+    /// Smallest and largest x, padded for the axis.
+    Data(f64, f64),
+    /// Exactly this range (distribution percentiles).
+    Fixed(Range<f64>),
+    /// Categories at 0, 1, 2, …
+    Categories(Vec<String>),
+}
+
+/// `(min, max)` of `values`, `None` if empty.
+fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    values.fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+    })
+}
+
+/// The shared axes: data extent padded by 5% (multiplicatively on log axes), the spec's y range
+/// if it gives one, and the axis titles.
+fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path) -> Result<Frame> {
+    let extent = kind.extent();
+    let log_error = |key: &str, lo: f64| {
+        Error::input(csv.display(), format!("figure.{key} asks for a log axis, but the data has a value {lo} ≤ 0"))
+    };
+    let (x, categories) = match extent.x {
+        XAxis::Data(lo, hi) => {
+            if figure.x_log && lo <= 0.0 {
+                return Err(log_error("x_log", lo));
+            }
+            (pad(lo, hi, figure.x_log), None)
+        }
+        XAxis::Fixed(range) => (range, None),
+        XAxis::Categories(names) => (-0.5..names.len() as f64 - 0.5, Some(names)),
+    };
+    let (lo, hi) = extent.y;
+    let y = match figure.y_range {
+        Some((lo, hi)) => lo..hi,
+        None if figure.y_log && lo <= 0.0 => return Err(log_error("y_log", lo)),
+        None if extent.from_zero && !figure.y_log => {
+            let padded = pad(lo.min(0.0), hi.max(0.0), false);
+            (if lo >= 0.0 { 0.0 } else { padded.start })..(if hi <= 0.0 { 0.0 } else { padded.end })
+        }
+        None => pad(lo, hi, figure.y_log),
+    };
+    let metric = METRICS.iter().find(|m| m.name == figure.metric).map_or(figure.metric.as_str(), |m| m.label);
+    let x_desc = match (&figure.x_label, &figure.x) {
+        (Some(label), _) => label.clone(),
+        (None, Some(column)) => column_label(column).to_string(),
+        (None, None) if figure.metric == "ovr" => "views, sorted by overdraw ratio (percentile)".to_string(),
+        (None, None) => "values, sorted (percentile)".to_string(),
+    };
+    Ok(Frame {
+        x,
+        y,
+        x_log: figure.x_log,
+        y_log: figure.y_log,
+        x_desc,
+        y_desc: figure.y_label.clone().unwrap_or_else(|| metric.to_string()),
+        categories,
+    })
+}
+
+/// `lo..hi` widened by 5% of the span each side (a ratio on log axes); a single value gets a
+/// span around it.
+fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
+    if log {
+        let ratio = if hi > lo { (hi / lo).powf(0.05) } else { 1.5 };
+        return lo / ratio..hi * ratio;
+    }
+    let margin = if hi > lo { (hi - lo) * 0.05 } else { lo.abs().max(1.0) * 0.1 };
+    lo - margin..hi + margin
+}
+
+/// An axis title for a CSV column, with its unit.
+fn column_label(column: &str) -> &str {
+    match column {
+        "cache_size" => "cache size (vertices)",
+        "model_triangles" => "triangles",
+        "model_vertices" => "vertices",
+        "seconds" => "ordering time (s)",
+        "res" => "image size (pixels per side)",
+        "view" => "view (index in the set)",
+        other => other,
+    }
+}
+
+/// Draws the whole figure into `svg`; `setup` (how the data was measured) goes under the title.
+fn draw(
+    svg: &mut String,
+    spec: &Spec,
+    setup: &str,
+    panels: &[Panel],
+    kind: &dyn Kind,
+    frame: &Frame,
+    colors: &Colors,
+) -> DrawResult {
+    let n = panels.len();
+    let cols = match n {
+        1 => 1,
+        2 | 4 => 2,
+        _ => 3,
+    };
+    let rows = n.div_ceil(cols);
+    let (panel_w, panel_h) = if n == 1 { (760, 500) } else { (540, 400) };
+    let width = (cols * panel_w) as u32;
+    let chars = |size: f64| (f64::from(width - 40) / (size * 0.55)) as usize;
+    let title = axes::wrap(&spec.title, chars(20.0));
+    let setup = axes::wrap(setup, chars(13.0));
+    let claim = spec.claim.as_deref().map_or_else(Vec::new, |c| axes::wrap(&format!("Paper: {c}"), chars(13.0)));
+    let header_h = 16 + 28 * title.len() as u32 + 18 * (setup.len() + claim.len()) as u32 + 10;
+    let legend_h = axes::legend_height(colors.entries(), width);
+    let height = header_h + (rows * panel_h) as u32 + legend_h;
+
+    let root = SVGBackend::with_string(svg, (width, height)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (header, rest) = root.split_vertically(header_h);
+    let (body, legend) = rest.split_vertically((rows * panel_h) as u32);
+
+    let center = Pos::new(HPos::Center, VPos::Top);
+    let title_style = TextStyle::from((FONT, 20).into_font().style(FontStyle::Bold)).pos(center);
+    let grey = RGBColor(0x44, 0x44, 0x44);
+    let setup_style = TextStyle::from((FONT, 13)).color(&grey).pos(center);
+    let claim_style = TextStyle::from((FONT, 13).into_font().style(FontStyle::Italic)).color(&grey).pos(center);
+    let mut y = 16;
+    for line in &title {
+        header.draw_text(line, &title_style, (width as i32 / 2, y))?;
+        y += 28;
+    }
+    for (line, style) in setup.iter().map(|l| (l, &setup_style)).chain(claim.iter().map(|l| (l, &claim_style))) {
+        header.draw_text(line, style, (width as i32 / 2, y))?;
+        y += 18;
+    }
+    for (i, (area, panel)) in body.split_evenly((rows, cols)).iter().zip(panels).enumerate() {
+        kind.draw(i, area, &panel.title, frame, colors)?;
+    }
+    axes::legend(&legend, colors.entries(), kind.swatch())?;
+    root.present()
+}

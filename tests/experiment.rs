@@ -1,0 +1,343 @@
+//! The experiment pipeline: spec → results CSV → SVG, checked end to end on procedural meshes in
+//! a temporary project root.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use triorder::eval::{MeasureOptions, evaluate};
+use triorder::experiment::row::COLUMNS;
+use triorder::experiment::{RunOptions, Spec, reproduce, run};
+use triorder::figure::{PlotOptions, plot};
+use triorder::mesh::source;
+use triorder::metrics::CacheModel;
+use triorder::topology::Topology;
+use triorder::{order, raster};
+
+/// A spec small enough to run in milliseconds: two procedural models (the grid is flat, so some
+/// of its views see nothing), three methods (a seed grid), three cache models and six views.
+const TINY: &str = r#"
+id = "tiny"
+title = "Tiny experiment"
+question = "Does the pipeline work?"
+claim = "It does (this test)."
+models = ["sphere:80", "grid:4x4"]
+methods = ["input", "random:seed={1,2}"]
+caches = ["fifo:4..8/4", "lru:16"]
+views = "axis6"
+res = 32
+seed = 3
+
+[figure]
+kind = "line"
+metric = "acmr"
+x = "cache_size"
+facet = "model"
+filter = { cache_kind = "fifo" }
+
+[quick]
+models = ["sphere:80", "grid:4x4"]
+"#;
+
+/// Writes `text` as `ROOT/experiments/ID.toml` and returns its path.
+fn write_spec(root: &Path, id: &str, text: &str) -> PathBuf {
+    let dir = root.join("experiments");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{id}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn quick(root: &Path) -> RunOptions {
+    RunOptions { quick: true, out_dir: root.to_path_buf(), ..RunOptions::default() }
+}
+
+fn plot_quick(root: &Path) -> PlotOptions {
+    PlotOptions { quick: true, out_dir: root.to_path_buf() }
+}
+
+/// The CSV as a list of column → value maps (and the header).
+fn read_csv(path: &Path) -> (Vec<String>, Vec<HashMap<String, String>>) {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    let rows =
+        reader.records().map(|r| header.iter().cloned().zip(r.unwrap().iter().map(String::from)).collect()).collect();
+    (header, rows)
+}
+
+/// The error `Spec::load` gives for `text` saved as `experiments/ID.toml`.
+fn spec_error(id: &str, text: &str) -> String {
+    let root = tempfile::tempdir().unwrap();
+    let path = write_spec(root.path(), id, text);
+    let err = Spec::load(&path).unwrap_err().to_string();
+    assert!(err.contains(&path.display().to_string()), "error does not name the file: {err}");
+    err
+}
+
+#[test]
+fn repository_specs_parse() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    let acmr = Spec::load(&dir.join("acmr-vs-fifo.toml")).unwrap();
+    assert_eq!(acmr.methods.len(), order::METHODS.len());
+    assert_eq!(acmr.full.caches.len(), 61);
+    assert_eq!(acmr.full.caches[0], CacheModel::Fifo(4));
+    assert_eq!(acmr.quick.as_ref().unwrap().caches.len(), 16);
+    let ovr = Spec::load(&dir.join("ovr-distribution-bunny.toml")).unwrap();
+    assert_eq!(ovr.full.views, Some("ico:162".parse().unwrap()));
+    assert_eq!((ovr.full.res, ovr.quick.as_ref().unwrap().res), (512, 128));
+    assert_eq!(ovr.methods, ["input", "meshopt-overdraw:threshold=1.05"]);
+}
+
+#[test]
+fn grids_expand_to_canonical_methods() {
+    let root = tempfile::tempdir().unwrap();
+    let spec = Spec::load(&write_spec(root.path(), "tiny", TINY)).unwrap();
+    assert_eq!(spec.methods, ["input", "random:seed=1", "random:seed=2"]);
+    let caches: Vec<String> = spec.full.caches.iter().map(ToString::to_string).collect();
+    assert_eq!(caches, ["fifo:4", "fifo:8", "lru:16"]);
+}
+
+#[test]
+fn bad_specs_name_the_key() {
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            r#"methods = ["input", "random:seed={1,2}"]"#,
+            r#"methods = ["input", "tipsy:cache=16"]"#,
+            &["methods[1]", "unknown method `tipsy`"],
+        ),
+        (
+            r#"methods = ["input", "random:seed={1,2}"]"#,
+            r#"methods = ["random:seed={1,2"]"#,
+            &["methods[0]", "without `}`"],
+        ),
+        (r#"methods = ["input", "random:seed={1,2}"]"#, r#"methods = "most""#, &["methods", "\"all\""]),
+        (
+            r#"methods = ["input", "random:seed={1,2}"]"#,
+            r#"methods = 3"#,
+            &["methods = 3", "expected \"all\" or a list"],
+        ),
+        (r#"caches = ["fifo:4..8/4", "lru:16"]"#, r#"caches = ["fifo:64..4"]"#, &["caches[0]", "empty range"]),
+        (r#"caches = ["fifo:4..8/4", "lru:16"]"#, r#"caches = ["fifo:4..8/0"]"#, &["caches[0]", "step"]),
+        (r#"caches = ["fifo:4..8/4", "lru:16"]"#, r#"caches = ["mru:4"]"#, &["caches[0]", "mru:4"]),
+        (r#"views = "axis6""#, r#"views = "ico:100""#, &["views", "ico:100"]),
+        (
+            r#"seed = 3"#,
+            r#"seed = 3
+modles = ["a"]"#,
+            &["modles"],
+        ),
+        (r#"id = "tiny""#, "", &["missing field `id`"]),
+        (r#"id = "tiny""#, r#"id = "other""#, &["id `other`", "file name"]),
+        (r#"x = "cache_size""#, r#"x = "cache_sise""#, &["figure.x", "cache_sise"]),
+        (r#"kind = "line""#, r#"kind = "pie""#, &["pie"]),
+        (r#"metric = "acmr""#, r#"metric = "acmrr""#, &["figure.metric", "acmrr"]),
+        (r#"kind = "line""#, "kind = \"bar\"\nx_log = true", &["figure.x_log", "bar"]),
+        (
+            r#"models = ["sphere:80", "grid:4x4"]
+"#,
+            r#"models = ["models/bunny_2k.ply"]
+"#,
+            &["quick.models[0]", "models/bunny_2k.ply"],
+        ),
+    ];
+    for (from, to, expected) in cases {
+        assert!(TINY.contains(from), "{from}");
+        let err = spec_error("tiny", &TINY.replacen(from, to, if from.starts_with("models") { 2 } else { 1 }));
+        for want in *expected {
+            assert!(err.contains(want), "`{to}`: error lacks `{want}`:\n{err}");
+        }
+    }
+    // `res` without `views`, and overdraw metrics without views.
+    let no_views = TINY.replace("views = \"axis6\"\n", "");
+    assert!(spec_error("tiny", &no_views).contains("res is set but views is not"));
+    let err =
+        spec_error("tiny", &no_views.replace("res = 32\n", "").replace("metric = \"acmr\"", "metric = \"ovr_mean\""));
+    assert!(err.contains("figure.metric = \"ovr_mean\" needs `views`"), "{err}");
+}
+
+#[test]
+fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
+    let root = tempfile::tempdir().unwrap();
+    let spec_path = write_spec(root.path(), "tiny", TINY);
+    let csv = run(&spec_path, &quick(root.path())).unwrap();
+    assert_eq!(csv, root.path().join("results/quick/tiny.csv"));
+    let (header, rows) = read_csv(&csv);
+    assert_eq!(header, COLUMNS);
+
+    let spec = Spec::load(&spec_path).unwrap();
+    let work = spec.workload(true).unwrap();
+    let options = MeasureOptions { caches: work.caches.clone(), views: work.views, res: work.res, seed: spec.seed };
+    let cpu = raster::backend("cpu").unwrap();
+    let mut expected_rows = 0;
+    for model in &work.models {
+        let mesh = source::open(model, None, spec.seed).unwrap();
+        let topology = Topology::new(&mesh);
+        for method in &spec.methods {
+            let direct =
+                evaluate(&mesh, &topology, &order::resolve(method, spec.seed).unwrap(), &options, cpu.as_ref())
+                    .unwrap();
+            let mine: Vec<_> = rows.iter().filter(|r| r["model"] == *model && r["method"] == *method).collect();
+            let value = |metric: &str, cache: &str, view: &str| -> f64 {
+                let hits: Vec<_> =
+                    mine.iter().filter(|r| r["metric"] == metric && r["cache"] == cache && r["view"] == view).collect();
+                assert_eq!(hits.len(), 1, "{model} {method} {metric} {cache} {view}");
+                hits[0]["value"].parse().unwrap()
+            };
+            for (cache, stats) in &direct.measurement.caches {
+                assert_eq!(value("acmr", &cache.to_string(), ""), stats.acmr());
+                assert_eq!(value("atvr", &cache.to_string(), ""), stats.atvr());
+            }
+            let overdraw = direct.measurement.overdraw.as_ref().unwrap();
+            let visible: Vec<_> =
+                overdraw.per_view.iter().enumerate().filter_map(|(i, v)| Some((i, v.ovr()?))).collect();
+            for &(i, ovr) in &visible {
+                assert_eq!(value("ovr", "", &i.to_string()), ovr);
+            }
+            assert_eq!(value("ovr_empty", "", "") as usize, 6 - visible.len());
+            let summary = overdraw.summary.unwrap();
+            assert_eq!(value("ovr_mean", "", ""), summary.mean);
+            assert_eq!(value("ovr_max", "", ""), summary.max);
+            assert_eq!(value("ovr_var", "", ""), summary.variance);
+            let r = mine[0];
+            assert_eq!(r["model_triangles"], mesh.triangle_count().to_string());
+            assert_eq!((r["method_name"].as_str(), r["seed"].as_str()), (method.split(':').next().unwrap(), "3"));
+            assert_eq!((r["backend"].as_str(), r["triorder"].as_str()), ("cpu", env!("CARGO_PKG_VERSION")));
+            assert!(!r["machine"].is_empty() && !r["commit"].is_empty());
+            // 3 caches × (acmr, atvr) + seconds + ovr_empty + 5 summaries + one row per visible view.
+            assert_eq!(mine.len(), 3 * 2 + 1 + 1 + 5 + visible.len());
+            expected_rows += mine.len();
+        }
+    }
+    assert_eq!(rows.len(), expected_rows);
+    let grid_empty: f64 =
+        rows.iter().find(|r| r["model"] == "grid:4x4" && r["metric"] == "ovr_empty").unwrap()["value"].parse().unwrap();
+    assert!(grid_empty > 0.0, "a flat grid is invisible from behind and edge-on");
+
+    // Plotting reads the CSV and names the title, the claim and every series.
+    let svg = plot(&spec_path, &plot_quick(root.path())).unwrap();
+    assert_eq!(svg, root.path().join("paper-figures/quick/tiny.svg"));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
+    for want in [
+        "Tiny experiment",
+        "It does (this test).",
+        "input",
+        "random:seed=1",
+        "random:seed=2",
+        "sphere:80 (80 triangles)",
+    ] {
+        assert!(text.contains(want), "SVG lacks `{want}`");
+    }
+}
+
+#[test]
+fn every_figure_kind_draws_from_one_csv() {
+    let root = tempfile::tempdir().unwrap();
+    let kinds = [
+        ("bars", "kind = \"bar\"\nmetric = \"acmr\"\nx = \"model\"\nfilter = { cache = \"fifo:8\" }", "grid:4x4"),
+        (
+            "points",
+            "kind = \"scatter\"\nmetric = \"acmr\"\nx = \"seconds\"\nseries = \"model\"\nx_log = true",
+            "sphere:80",
+        ),
+        ("views", "kind = \"distribution\"\nmetric = \"ovr\"\nfacet = \"model\"\ny_log = true", "mean "),
+    ];
+    for (id, figure, want) in kinds {
+        let text = TINY.replace("id = \"tiny\"", &format!("id = \"{id}\"")).replace(
+            "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
+            figure,
+        );
+        let path = write_spec(root.path(), id, &text);
+        run(&path, &quick(root.path())).unwrap();
+        let svg = std::fs::read_to_string(plot(&path, &plot_quick(root.path())).unwrap()).unwrap();
+        assert!(svg.contains(want), "{id}: SVG lacks `{want}`");
+    }
+}
+
+#[test]
+fn plotting_without_results_or_with_unusable_results_says_why() {
+    let root = tempfile::tempdir().unwrap();
+    let path = write_spec(root.path(), "tiny", TINY);
+    let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
+    assert!(err.contains("results/quick/tiny.csv") && err.contains("run the experiment first"), "{err}");
+    assert!(!root.path().join("paper-figures").exists());
+
+    // A line chart needs a numeric x.
+    run(&path, &quick(root.path())).unwrap();
+    let by_model =
+        TINY.replace("x = \"cache_size\"", "x = \"model\"").replace("cache_kind = \"fifo\"", "cache = \"fifo:8\"");
+    std::fs::write(&path, by_model).unwrap();
+    let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
+    assert!(err.contains("column `model`") && err.contains("not a number"), "{err}");
+    // Two rows at one point of a line (fifo and lru both at size 16) are ambiguous.
+    let mixed = TINY
+        .replace("caches = [\"fifo:4..8/4\", \"lru:16\"]", "caches = [\"fifo:16\", \"lru:16\"]")
+        .replace("filter = { cache_kind = \"fifo\" }", "");
+    std::fs::write(&path, mixed).unwrap();
+    run(&path, &quick(root.path())).unwrap();
+    let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
+    assert!(err.contains("a second `acmr` row") && err.contains("figure.filter"), "{err}");
+}
+
+#[test]
+fn missing_models_are_refused_before_any_work() {
+    let root = tempfile::tempdir().unwrap();
+    let text =
+        TINY.replacen("models = [\"sphere:80\", \"grid:4x4\"]", "models = [\"sphere:80\", \"models/nowhere.ply\"]", 1);
+    let path = write_spec(root.path(), "tiny", &text);
+    let opts = RunOptions {
+        data: Some(root.path().join("data")),
+        ..RunOptions { out_dir: root.path().into(), ..RunOptions::default() }
+    };
+    let err = run(&path, &opts).unwrap_err().to_string();
+    for want in ["models[1]", "models/nowhere.ply", "--data", "TRIORDER_DATA", "scripts/fetch-data.sh"] {
+        assert!(err.contains(want), "error lacks `{want}`: {err}");
+    }
+    assert!(!root.path().join("results").exists());
+    // --quick on a spec without a [quick] table.
+    let no_quick = TINY[..TINY.find("[quick]").unwrap()].to_string();
+    std::fs::write(&path, no_quick).unwrap();
+    assert!(run(&path, &quick(root.path())).unwrap_err().to_string().contains("[quick]"));
+}
+
+#[test]
+fn a_failed_run_leaves_the_previous_results_whole() {
+    let root = tempfile::tempdir().unwrap();
+    let path = write_spec(root.path(), "tiny", TINY);
+    let opts = RunOptions { out_dir: root.path().into(), ..RunOptions::default() };
+    let csv = run(&path, &opts).unwrap();
+    assert_eq!(csv, root.path().join("results/tiny.csv"));
+    let before = std::fs::read(&csv).unwrap();
+    // The second model exists but is not a valid mesh: the run fails after the first model's work.
+    let broken = root.path().join("broken.obj");
+    std::fs::write(&broken, "v 0 0 0\nf 1 2 3\n").unwrap();
+    let models = format!("models = [\"sphere:80\", \"{}\"]", broken.display());
+    std::fs::write(&path, TINY.replacen("models = [\"sphere:80\", \"grid:4x4\"]", &models, 1)).unwrap();
+    let err = run(&path, &opts).unwrap_err().to_string();
+    assert!(err.contains("broken.obj"), "{err}");
+    assert_eq!(std::fs::read(&csv).unwrap(), before, "the previous CSV is untouched");
+    let files: Vec<_> = std::fs::read_dir(csv.parent().unwrap()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(files, ["tiny.csv"], "no temporary file is left behind");
+}
+
+#[test]
+fn reproduce_runs_and_plots_every_matching_spec_in_order() {
+    let root = tempfile::tempdir().unwrap();
+    write_spec(root.path(), "tiny", TINY);
+    write_spec(root.path(), "another", &TINY.replace("id = \"tiny\"", "id = \"another\""));
+    let outputs = reproduce(&quick(root.path()), None).unwrap();
+    let ids: Vec<_> = outputs.iter().map(|(csv, _)| csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
+    assert_eq!(ids, ["another", "tiny"]);
+    assert!(outputs.iter().all(|(csv, svg)| csv.is_file() && svg.is_file()));
+    assert_eq!(reproduce(&quick(root.path()), Some("tin")).unwrap().len(), 1);
+    let err = reproduce(&quick(root.path()), Some("nothing")).unwrap_err().to_string();
+    assert!(err.contains("matching `nothing`"), "{err}");
+    // A broken spec stops everything before any run.
+    write_spec(
+        root.path(),
+        "broken",
+        &TINY.replace("id = \"tiny\"", "id = \"broken\"").replace("\"input\"", "\"nope\""),
+    );
+    std::fs::remove_dir_all(root.path().join("results")).unwrap();
+    assert!(reproduce(&quick(root.path()), None).unwrap_err().to_string().contains("broken.toml"));
+    assert!(!root.path().join("results").exists());
+}
