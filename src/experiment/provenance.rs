@@ -14,8 +14,10 @@ pub fn machine() -> String {
     format!("{cpu} ({threads} threads)")
 }
 
-/// `git rev-parse --short HEAD` of the working directory, `-dirty` when the tree has changes,
-/// `unknown` outside git (or before the first commit).
+/// `git rev-parse --short HEAD` of the working directory, `-dirty` when anything but the
+/// experiment outputs (results/, paper-figures/) differs from it, `unknown` outside git (or
+/// before the first commit). Outputs are excluded so that regenerating one figure does not mark
+/// the next one of the same run as built from modified code.
 pub fn commit() -> String {
     let git = |args: &[&str]| {
         std::process::Command::new("git")
@@ -27,7 +29,7 @@ pub fn commit() -> String {
     };
     match git(&["rev-parse", "--short", "HEAD"]) {
         None => "unknown".into(),
-        Some(hash) => match git(&["status", "--porcelain"]) {
+        Some(hash) => match git(&["status", "--porcelain", "--", ".", ":!results", ":!paper-figures"]) {
             Some(changes) if !changes.is_empty() => format!("{hash}-dirty"),
             _ => hash,
         },
