@@ -2,7 +2,9 @@
 //! triangulation, OBJ groups, PLY encodings, glTF node transforms and primitive modes), and the
 //! real models of the data directory loading with the triangle counts its MANIFEST.md states.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 
 use glam::Vec3;
 use triorder::mesh::load::{load_file, load_file_with_report};
@@ -333,23 +335,9 @@ fn gltf_applies_node_transforms_and_converts_strips_and_fans() {
     assert_eq!(normals[4], [0.0, 0.0, -1.0]);
 }
 
-/// The data directory: `$TRIORDER_DATA`, else `../shared/data` beside the crate; `None` (and a
-/// notice) when it is absent, as in a fresh clone without the models.
-fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("TRIORDER_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("notice: no data directory at {} (set TRIORDER_DATA); skipping", dir.display());
-        None
-    }
-}
-
 #[test]
 fn every_model_loads_with_the_manifest_triangle_count() {
-    let Some(data) = data_dir() else { return };
+    let Some(data) = common::data_dir() else { return };
     let expected = [
         ("bun_zipper.ply", 69_451),
         ("bunny_2k.ply", 2_000),
@@ -374,7 +362,7 @@ fn every_model_loads_with_the_manifest_triangle_count() {
 
 #[test]
 fn model_attributes_are_kept() {
-    let Some(data) = data_dir() else { return };
+    let Some(data) = common::data_dir() else { return };
     let models = data.join("models");
     let bunny = load_file(&models.join("bun_zipper.ply")).unwrap();
     assert_eq!(bunny.vertex_count(), 35_947, "unused vertices are kept in PLY");
@@ -389,7 +377,7 @@ fn model_attributes_are_kept() {
 
 #[test]
 fn animated_glbs_load_their_rest_pose_meshes() {
-    let Some(data) = data_dir() else { return };
+    let Some(data) = common::data_dir() else { return };
     // MANIFEST.md's counts are of the skinned meshes; for every file but RobotExpressive (whose
     // rigid parts are listed apart) that is the whole file.
     let expected = [
