@@ -84,12 +84,21 @@ pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
             std::hint::black_box(CpuRaster.count(positions, drawn, &cameras, res).ok());
         }
     };
-    let ours = median_seconds(reps, overdraw(ViewSet::Axis6, 256));
     let adapter = peer::positions(mesh);
     let theirs = median_seconds(reps, || {
         std::hint::black_box(meshopt::analyze_overdraw(&indices, &adapter));
     });
-    rows.push(row("overdraw axis6@256 (meshopt: its 6 views@256)", ours, Some(theirs)));
+    // meshopt rasterises on one thread; compare like with like first, then our default.
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().map(|pool| {
+        let mut time = overdraw(ViewSet::Axis6, 256);
+        pool.install(|| median_seconds(reps, &mut time))
+    });
+    if let Ok(ours) = one_thread {
+        rows.push(row("overdraw axis6@256, 1 thread (meshopt: 6 views@256)", ours, Some(theirs)));
+    }
+    let ours = median_seconds(reps, overdraw(ViewSet::Axis6, 256));
+    let threads = rayon::current_num_threads();
+    rows.push(row(&format!("overdraw axis6@256, {threads} threads"), ours, Some(theirs)));
     let ico = median_seconds(reps.min(5), overdraw(ViewSet::Ico(162), 512));
     rows.push(row("overdraw ico:162@512", ico, None));
     rows

@@ -155,22 +155,25 @@ fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
 /// submitted and the cache emptied. A repeated corner counts once per corner in that test, as
 /// there.
 fn batch(k: u32, warp: u32, primgroup: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+    // A disabled limit becomes one no batch can reach, which keeps the loop free of extra tests.
+    let off_is_max = |limit: u32| if limit == 0 { u32::MAX } else { limit };
+    let (warp, primgroup) = (off_is_max(warp), off_is_max(primgroup));
     let mut stamp = vec![0u32; vertex_count];
     let mut now = k + 1;
     let (mut misses, mut batches) = (0u64, 0u64);
     let (mut in_warp, mut in_group) = (0u32, 0u32);
     for tri in triangles {
-        let missing: u32 = tri.iter().map(|&v| u32::from(now - stamp[v as usize] > k)).sum();
-        if (primgroup != 0 && in_group == primgroup) || (warp != 0 && in_warp + missing > warp) {
+        let [a, b, c] = tri.map(|v| v as usize);
+        let missing = u32::from(now - stamp[a] > k) + u32::from(now - stamp[b] > k) + u32::from(now - stamp[c] > k);
+        if in_group == primgroup || in_warp.saturating_add(missing) > warp {
             batches += u64::from(in_warp > 0);
             in_warp = 0;
             in_group = 0;
             now += k + 1;
         }
-        for &v in tri {
-            let s = &mut stamp[v as usize];
-            if now - *s > k {
-                *s = now;
+        for v in [a, b, c] {
+            if now - stamp[v] > k {
+                stamp[v] = now;
                 now += 1;
                 misses += 1;
                 in_warp += 1;
