@@ -16,7 +16,7 @@ use super::spec::Spec;
 use crate::error::{Error, Result};
 use crate::eval::{MeasureOptions, evaluate};
 use crate::mesh::report::MeshReport;
-use crate::mesh::{procedural, source};
+use crate::mesh::source;
 use crate::order;
 use crate::topology::Topology;
 use crate::{atomic, figure, raster};
@@ -133,25 +133,9 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
     Ok(path)
 }
 
-/// Fails before any work if `model` cannot be opened: a bad procedural spec, or a file that is
-/// neither where the spec says nor in the data directory.
+/// Fails before any work if `model` cannot be opened, naming the spec key.
 fn check_model(spec: &Spec, key: &str, model: &str, data: Option<&Path>) -> Result<()> {
-    if let Some(generated) = procedural::generate(model, spec.seed) {
-        return generated.map(drop).map_err(|e| Error::spec(&spec.path, format!("{key}: {e}")));
-    }
-    if Path::new(model).exists() || data.is_some_and(|d| d.join(model).exists()) {
-        return Ok(());
-    }
-    let looked = match data {
-        Some(dir) => format!("not found here or in the data directory {}", dir.display()),
-        None => "not found, and there is no data directory".to_string(),
-    };
-    Err(Error::spec(
-        &spec.path,
-        format!(
-            "{key} `{model}`: {looked}; give --data DIR or set TRIORDER_DATA to the directory holding models/, or run scripts/fetch-data.sh to download the models"
-        ),
-    ))
+    source::check(model, data).map_err(|e| Error::spec(&spec.path, format!("{key}: {e}")))
 }
 
 /// Writes `rows` as CSV to `path` atomically, creating its directory.

@@ -310,7 +310,7 @@ impl RawSpec {
 
 /// True for models a fresh clone has: procedural specs and the bundled `assets/` files.
 fn is_bundled(model: &str) -> bool {
-    model.starts_with("assets/") || procedural::generate(model, 0).is_some()
+    model.starts_with("assets/") || procedural::check(model).is_some()
 }
 
 /// Expands and resolves the method list; the canonical specs, deduplicated, in order.

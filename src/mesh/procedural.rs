@@ -38,26 +38,71 @@ pub const HELIX_SEGMENTS_PER_TURN: u32 = 48;
 /// Sides of the tube's polygonal cross-section (`helix:T`).
 pub const HELIX_SIDES: u32 = 12;
 
+/// A parsed procedural spec, checked but not yet built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Shape {
+    Grid { w: u64, h: u64 },
+    Disk { n: u64 },
+    Sphere { f: u64 },
+    Helix { turns: u64 },
+    Layers { k: u64 },
+}
+
+impl Shape {
+    /// The triangle count the shape will have, `None` on overflow.
+    fn triangles(self) -> Option<u64> {
+        let (segments, sides) = (u64::from(HELIX_SEGMENTS_PER_TURN), u64::from(HELIX_SIDES));
+        match self {
+            Shape::Grid { w, h } => w.checked_mul(h)?.checked_mul(2),
+            Shape::Disk { n } => Some(n),
+            Shape::Sphere { f } => f.checked_mul(f)?.checked_mul(20),
+            Shape::Helix { turns } => turns.checked_mul(2 * segments * sides)?.checked_add(2 * sides),
+            Shape::Layers { k } => k.checked_mul(2),
+        }
+    }
+}
+
+/// Parses and checks `spec` without building anything: `None` if it is not procedural (then it
+/// is a path), else whether it is well formed and within [`MAX_TRIANGLES`].
+fn shape(spec: &str) -> Option<Result<Shape>> {
+    let (kind, args) = spec.split_once(':')?;
+    let parsed = match kind {
+        "grid" => parse::<2>(spec, args, "width and height must be integers ≥ 1, as in grid:16x8")
+            .map(|[w, h]| Shape::Grid { w, h }),
+        "disk" => parse::<1>(spec, args, "the triangle count must be an integer ≥ 1, as in disk:950")
+            .map(|[n]| Shape::Disk { n }),
+        "sphere" => parse::<1>(spec, args, "the triangle count must be an integer ≥ 1, as in sphere:20480")
+            .map(|[n]| Shape::Sphere { f: (((n as f64) / 20.0).sqrt().round() as u64).max(1) }),
+        "helix" => parse::<1>(spec, args, "the number of turns must be an integer ≥ 1, as in helix:4")
+            .map(|[turns]| Shape::Helix { turns }),
+        "layers" => parse::<1>(spec, args, "the number of layers must be an integer ≥ 1, as in layers:8")
+            .map(|[k]| Shape::Layers { k }),
+        _ => return None,
+    };
+    Some(parsed.and_then(|shape| match shape.triangles() {
+        Some(t) if t <= MAX_TRIANGLES => Ok(shape),
+        _ => Err(Error::input(spec, format!("too large: at most {MAX_TRIANGLES} triangles are supported"))),
+    }))
+}
+
+/// Whether `spec` names a procedural mesh and is valid, without building it (cheap: for
+/// checking experiment specs before any work). `None` when `spec` is a path.
+pub fn check(spec: &str) -> Option<Result<()>> {
+    shape(spec).map(|s| s.map(drop))
+}
+
 /// The mesh named by `spec`, or `None` if `spec` does not start with `grid:`, `disk:`,
 /// `sphere:`, `helix:` or `layers:` (then it is a file path). `seed` is used by `disk` only.
 /// The mesh is named `spec`; a malformed spec gives an [`Error::Input`] naming it and showing
 /// the expected form.
 pub fn generate(spec: &str, seed: u64) -> Option<Result<Mesh>> {
-    let (kind, args) = spec.split_once(':')?;
-    let mesh = match kind {
-        "grid" => parse::<2>(spec, args, "width and height must be integers ≥ 1, as in grid:16x8")
-            .and_then(|[w, h]| grid(spec, w, h)),
-        "disk" => parse::<1>(spec, args, "the triangle count must be an integer ≥ 1, as in disk:950")
-            .and_then(|[n]| disk(spec, n, seed)),
-        "sphere" => parse::<1>(spec, args, "the triangle count must be an integer ≥ 1, as in sphere:20480")
-            .and_then(|[n]| sphere(spec, n)),
-        "helix" => parse::<1>(spec, args, "the number of turns must be an integer ≥ 1, as in helix:4")
-            .and_then(|[t]| helix(spec, t)),
-        "layers" => parse::<1>(spec, args, "the number of layers must be an integer ≥ 1, as in layers:8")
-            .and_then(|[k]| layers(spec, k)),
-        _ => return None,
-    };
-    Some(mesh)
+    Some(shape(spec)?.and_then(|shape| match shape {
+        Shape::Grid { w, h } => grid(spec, w, h),
+        Shape::Disk { n } => disk(spec, n, seed),
+        Shape::Sphere { f } => sphere(spec, f),
+        Shape::Helix { turns } => helix(spec, turns),
+        Shape::Layers { k } => layers(spec, k),
+    }))
 }
 
 /// The `K` integers ≥ 1 of `args`, separated by `x` (`16x8` for `K = 2`, `950` for `K = 1`).
@@ -79,14 +124,6 @@ fn parse<const K: usize>(spec: &str, args: &str, expected: &str) -> Result<[u64;
     Ok(values)
 }
 
-/// Refuses specs that would produce more than [`MAX_TRIANGLES`] triangles.
-fn check_size(spec: &str, triangles: Option<u64>) -> Result<()> {
-    match triangles {
-        Some(t) if t <= MAX_TRIANGLES => Ok(()),
-        _ => Err(Error::input(spec, format!("too large: at most {MAX_TRIANGLES} triangles are supported"))),
-    }
-}
-
 /// `grid:WxH`, the regular triangulated grid of Bogomjakov & Gotsman 2002, Fig. 2 (16×8 there):
 /// W×H unit squares in the z = 0 plane, x in 0..=W, y in 0..=H.
 ///
@@ -98,7 +135,6 @@ fn check_size(spec: &str, triangles: Option<u64>) -> Result<()> {
 /// counter-clockwise seen from +z. Draw order is therefore a row-by-row raster that always runs
 /// in +x (not a snake).
 fn grid(spec: &str, w: u64, h: u64) -> Result<Mesh> {
-    check_size(spec, w.checked_mul(h).and_then(|s| s.checked_mul(2)))?;
     let (w, h) = (w as u32, h as u32);
     let positions = (0..=h).flat_map(|y| (0..=w).map(move |x| Vec3::new(x as f32, y as f32, 0.0))).collect();
     let vertex = |x: u32, y: u32| y * (w + 1) + x;
@@ -127,7 +163,6 @@ fn grid(spec: &str, w: u64, h: u64) -> Result<Mesh> {
 /// B would reach N + 2) there are no interior points and the polygon is fanned by the
 /// triangulation.
 fn disk(spec: &str, n: u64, seed: u64) -> Result<Mesh> {
-    check_size(spec, Some(n))?;
     let boundary_guess = ((2.15 * (n as f64).sqrt()).round() as u64).max(3);
     let boundary = if boundary_guess >= n + 2 { n + 2 } else { boundary_guess + (n + boundary_guess) % 2 };
     let interior = (n + 2 - boundary) / 2;
@@ -260,9 +295,7 @@ impl PointGrid {
 /// inner): for each (i, j) the "upward" triangle [(i,j), (i+1,j), (i,j+1)] then, if i + j < f − 1,
 /// the "downward" one [(i+1,j), (i+1,j+1), (i,j+1)]. Vertices are numbered in order of first
 /// use.
-fn sphere(spec: &str, n: u64) -> Result<Mesh> {
-    let f = (((n as f64) / 20.0).sqrt().round() as u64).max(1);
-    check_size(spec, Some(20 * f * f))?;
+fn sphere(spec: &str, f: u64) -> Result<Mesh> {
     let f = f as u32;
     let (corners, faces) = icosahedron();
     // A point of a face is Σ weightₖ·cornerₖ / f with integer weights: keyed by its sorted
@@ -338,9 +371,7 @@ fn icosahedron() -> ([DVec3; 12], Vec<[u32; 3]>) {
 /// `[c(0), a_k, a_k+1]` over ring 0 and the end cap's fan `[c(2πT), b_k+1, b_k]` over the last
 /// ring. That is 12(48T + 1) + 2 vertices and 1152T + 24 triangles, closed and wound outward.
 fn helix(spec: &str, turns: u64) -> Result<Mesh> {
-    let (segments, sides) = (u64::from(HELIX_SEGMENTS_PER_TURN), u64::from(HELIX_SIDES));
-    check_size(spec, turns.checked_mul(2 * segments * sides).map(|t| t + 2 * sides))?;
-    let rings = (segments * turns + 1) as u32;
+    let rings = (u64::from(HELIX_SEGMENTS_PER_TURN) * turns + 1) as u32;
     let sides = HELIX_SIDES;
     let (radius, rise) = (f64::from(HELIX_RADIUS), f64::from(HELIX_PITCH) / std::f64::consts::TAU);
     let centre = |theta: f64| DVec3::new(radius * theta.cos(), radius * theta.sin(), rise * theta);
@@ -383,7 +414,6 @@ fn helix(spec: &str, turns: u64) -> Result<Mesh> {
 /// covered pixel, and under a projection along −z (where all layers cover the same pixels) the
 /// overdraw ratio (shaded samples / covered samples) is exactly K. Reversing the order gives 1.
 fn layers(spec: &str, k: u64) -> Result<Mesh> {
-    check_size(spec, k.checked_mul(2))?;
     let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
     let positions = (0..k as u32).flat_map(|i| corners.map(|(x, y)| Vec3::new(x, y, i as f32))).collect();
     let triangles =

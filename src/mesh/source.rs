@@ -25,21 +25,37 @@ pub fn data_dir(explicit: Option<&Path>) -> Option<PathBuf> {
 /// Loads `source`: a procedural spec, an existing path, or a path relative to `data`.
 /// `seed` drives seeded generators (`disk:N`).
 pub fn open(source: &str, data: Option<&Path>, seed: u64) -> Result<Mesh> {
-    if let Some(generated) = procedural::generate(source, seed) {
-        return generated;
+    match procedural::generate(source, seed) {
+        Some(generated) => generated,
+        None => load::load_file(&locate_file(source, data)?),
     }
+}
+
+/// Checks that `source` can be opened, without reading or generating it: a well-formed
+/// procedural spec, or a file that exists. Lets a long run fail before any work.
+pub fn check(source: &str, data: Option<&Path>) -> Result<()> {
+    match procedural::check(source) {
+        Some(checked) => checked,
+        None => locate_file(source, data).map(drop),
+    }
+}
+
+/// The file `source` names: the path as given if it exists, else the same path inside `data`.
+/// The error says where it looked and how to get the models.
+fn locate_file(source: &str, data: Option<&Path>) -> Result<PathBuf> {
     let direct = Path::new(source);
     if direct.exists() {
-        return load::load_file(direct);
+        return Ok(direct.to_path_buf());
     }
-    match data {
-        Some(dir) if dir.join(source).exists() => load::load_file(&dir.join(source)),
-        Some(dir) => {
-            Err(Error::input(source, format!("no such file, here or in the data directory {}", dir.display())))
-        }
-        None => Err(Error::input(
-            source,
-            "no such file, and no data directory (give --data DIR or set TRIORDER_DATA; scripts/fetch-data.sh downloads the models)",
-        )),
-    }
+    let looked = match data {
+        Some(dir) if dir.join(source).exists() => return Ok(dir.join(source)),
+        Some(dir) => format!("no such file, here or in the data directory {}", dir.display()),
+        None => "no such file, and no data directory".to_string(),
+    };
+    Err(Error::input(
+        source,
+        format!(
+            "{looked}; give --data DIR or set TRIORDER_DATA to the directory holding models/, or run scripts/fetch-data.sh to download the models"
+        ),
+    ))
 }
