@@ -52,7 +52,7 @@ fn quick(root: &Path) -> RunOptions {
 }
 
 fn plot_quick(root: &Path) -> PlotOptions {
-    PlotOptions { quick: true, out_dir: root.to_path_buf() }
+    PlotOptions { quick: true, out_dir: root.to_path_buf(), data: None }
 }
 
 /// The CSV as a list of column → value maps (and the header).
@@ -76,9 +76,14 @@ fn spec_error(id: &str, text: &str) -> String {
 #[test]
 fn repository_specs_parse() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
-    let acmr = Spec::load(&dir.join("acmr-vs-fifo.toml")).unwrap();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let spec = Spec::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(spec.quick.is_some(), "{} has no [quick] table", path.display());
+    }
+    let acmr = Spec::load(&dir.join("universal-acmr-vs-cache.toml")).unwrap();
     assert_eq!(acmr.methods.len(), order::METHODS.len());
-    assert_eq!(acmr.full.caches.len(), 61);
+    assert_eq!(acmr.full.caches.len(), 31);
     assert_eq!(acmr.full.caches[0], CacheModel::Fifo(4));
     assert_eq!(acmr.quick.as_ref().unwrap().caches.len(), 16);
     let ovr = Spec::load(&dir.join("ovr-distribution-bunny.toml")).unwrap();
@@ -240,6 +245,9 @@ fn every_figure_kind_draws_from_one_csv() {
             "sphere:80",
         ),
         ("views", "kind = \"distribution\"\nmetric = \"ovr\"\nfacet = \"model\"\ny_log = true", "mean "),
+        ("numbers", "kind = \"table\"\nmetric = \"acmr\"\nx = \"model\"\nfilter = { cache = \"fifo:8\" }", "grid:4x4"),
+        ("paths", "kind = \"sequence\"\nmetric = \"acmr\"", "<polygon"),
+        ("pictures", "kind = \"corners\"\nmetric = \"acmr\"\nview = [1, 1, 1]", "data:image/png;base64,"),
     ];
     for (id, figure, want) in kinds {
         let text = TINY.replace("id = \"tiny\"", &format!("id = \"{id}\"")).replace(
@@ -340,4 +348,53 @@ fn reproduce_runs_and_plots_every_matching_spec_in_order() {
     std::fs::remove_dir_all(root.path().join("results")).unwrap();
     assert!(reproduce(&quick(root.path()), None).unwrap_err().to_string().contains("broken.toml"));
     assert!(!root.path().join("results").exists());
+}
+
+#[test]
+fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
+    let root = tempfile::tempdir().unwrap();
+    let text = TINY.replace("id = \"tiny\"", "id = \"corners\"").replace(
+        "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
+        "kind = \"corners\"\nmetric = \"acmr\"",
+    );
+    let path = write_spec(root.path(), "corners", &text);
+    run(&path, &quick(root.path())).unwrap();
+    let orders = root.path().join("results/quick/corners.orders.csv");
+    let (header, rows) = read_csv(&orders);
+    assert_eq!(header, ["model", "method", "position", "triangle"]);
+    // Every (model, method) pair saved as a whole order: 80 + 32 triangles, three methods.
+    assert_eq!(rows.len(), 3 * (80 + 32));
+    let svg = std::fs::read_to_string(plot(&path, &plot_quick(root.path())).unwrap()).unwrap();
+    // Two models × three methods × three caches, one picture each.
+    assert_eq!(svg.matches("<image").count(), 18);
+
+    // Swap two triangles of one saved order: its corner counts no longer match the CSV's ACMR.
+    let text = std::fs::read_to_string(&orders).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let input_row = |i: usize| lines.iter().position(|l| l.starts_with(&format!("sphere:80,input,{i},"))).unwrap();
+    let (a, b) = (input_row(0), input_row(40));
+    let (ta, tb) = (lines[a].rsplit(',').next().unwrap().to_string(), lines[b].rsplit(',').next().unwrap().to_string());
+    lines[a] = format!("sphere:80,input,0,{tb}");
+    lines[b] = format!("sphere:80,input,40,{ta}");
+    std::fs::write(&orders, lines.join("\n") + "\n").unwrap();
+    let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
+    assert!(err.contains("corners.orders.csv") && err.contains("rerun the experiment"), "{err}");
+}
+
+#[test]
+fn simplified_models_are_named_with_their_triangle_count() {
+    let mesh = source::open("assets/spot.obj@1000", None, 0).unwrap();
+    assert!((980..=1020).contains(&mesh.triangle_count()), "{}", mesh.triangle_count());
+    assert!(mesh.triangles.iter().flatten().all(|&v| (v as usize) < mesh.vertex_count()));
+    // No unused vertices are kept.
+    let mut used = vec![false; mesh.vertex_count()];
+    mesh.triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
+    assert!(used.iter().all(|&u| u));
+    let simplified_grid = source::open("grid:20x20@200", None, 0).unwrap();
+    assert!((196..=204).contains(&simplified_grid.triangle_count()), "{}", simplified_grid.triangle_count());
+    for (bad, want) in [("assets/spot.obj@0", "positive"), ("assets/spot.obj@9999999", "only 5856")] {
+        let err = source::open(bad, None, 0).unwrap_err().to_string();
+        assert!(err.contains(bad) && err.contains(want), "{err}");
+        assert!(source::check(bad, None).is_err() || want == "only 5856");
+    }
 }

@@ -9,12 +9,13 @@
 use serde::Serialize;
 
 use crate::eval::Evaluation;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, simplify};
 
 /// The CSV header, in order (checked against [`Row`] by a test).
 pub const COLUMNS: &[&str] = &[
     "experiment",
     "model",
+    "model_base",
     "model_triangles",
     "model_vertices",
     "method",
@@ -73,6 +74,8 @@ pub const METRICS: &[Metric] = &[
 pub struct Row {
     pub experiment: String,
     pub model: String,
+    /// The model without its `@N` resolution suffix: the series of a resolution sweep.
+    pub model_base: String,
     pub model_triangles: usize,
     pub model_vertices: usize,
     /// Canonical method spec (every parameter).
@@ -113,6 +116,7 @@ impl Context {
         let base = Row {
             experiment: self.experiment.clone(),
             model: model.to_string(),
+            model_base: simplify::parse_source(model).map_or(model, |(base, _)| base).to_string(),
             model_triangles: mesh.triangle_count(),
             model_vertices: mesh.vertex_count(),
             method: eval.method.clone(),
@@ -170,6 +174,16 @@ impl Context {
     }
 }
 
+/// One line of a drawing spec's orders file: the `position`-th triangle drawn.
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
+pub struct OrderRow {
+    pub model: String,
+    /// Canonical method spec, as in the results CSV.
+    pub method: String,
+    pub position: usize,
+    pub triangle: u32,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -179,6 +193,7 @@ mod tests {
         let row = Row {
             experiment: String::new(),
             model: String::new(),
+            model_base: String::new(),
             model_triangles: 0,
             model_vertices: 0,
             method: String::new(),

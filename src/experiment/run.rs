@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::provenance;
-use super::row::{Context, Row};
+use super::row::{Context, OrderRow, Row};
 use super::spec::Spec;
 use crate::error::{Error, Result};
 use crate::eval::{MeasureOptions, evaluate};
@@ -75,7 +75,7 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Vec<(PathBuf
     let bars = bars(opts.progress);
     let overall = bars.add(ProgressBar::new(specs.len() as u64));
     overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));
-    let plot = figure::PlotOptions { quick: opts.quick, out_dir: opts.out_dir.clone() };
+    let plot = figure::PlotOptions { quick: opts.quick, out_dir: opts.out_dir.clone(), data: opts.data.clone() };
     let mut outputs = Vec::new();
     for spec in &specs {
         overall.set_message(spec.id.clone());
@@ -111,6 +111,8 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
     bar.set_style(style("{prefix} {pos}/{len} {bar:30} {elapsed} {wide_msg}"));
     bar.set_prefix(spec.id.clone());
     let mut rows: Vec<Row> = Vec::new();
+    let mut orders: Vec<OrderRow> = Vec::new();
+    let save_orders = spec.figure.kind.draws_meshes();
     for model in &work.models {
         bar.set_message(format!("{model}: loading"));
         let mesh = source::open(model, data.as_deref(), spec.seed)?;
@@ -122,12 +124,23 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
             bar.set_message(format!("{model} · {}", method.canonical()));
             let evaluation = evaluate(&mesh, &topology, method, &measure, raster.as_ref())?;
             rows.extend(context.rows(model, &mesh, method.method.name, &evaluation));
+            if save_orders {
+                orders.extend(evaluation.order.iter().enumerate().map(|(position, &triangle)| OrderRow {
+                    model: model.clone(),
+                    method: evaluation.method.clone(),
+                    position,
+                    triangle,
+                }));
+            }
             bar.inc(1);
         }
     }
     bar.finish_and_clear();
     bars.remove(&bar);
 
+    if save_orders {
+        write_csv(&spec.orders_path(&opts.out_dir, opts.quick), &orders)?;
+    }
     let path = spec.csv_path(&opts.out_dir, opts.quick);
     write_csv(&path, &rows)?;
     Ok(path)
@@ -139,7 +152,7 @@ fn check_model(spec: &Spec, key: &str, model: &str, data: Option<&Path>) -> Resu
 }
 
 /// Writes `rows` as CSV to `path` atomically, creating its directory.
-fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
+fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| Error::output(path, e))?;
     }

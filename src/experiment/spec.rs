@@ -30,11 +30,13 @@
 //! backend = "cpu"                  # optional (default cpu): the raster backend
 //!
 //! [figure]
-//! kind = "line"                    # line | scatter | bar | distribution
+//! kind = "line"                    # line | scatter | bar | distribution | table |
+//!                                  # sequence | corners (drawings of the meshes)
 //! metric = "acmr"                  # the y values: rows whose `metric` column is this
 //!                                  # (acmr, atvr, seconds, ovr, ovr_mean, ovr_max, ovr_min,
 //!                                  # ovr_var, ovr_sum, ovr_empty)
 //! x = "cache_size"                 # CSV column on x (line, scatter: numeric; bar: categories;
+//!                                  # table: its rows;
 //!                                  # distribution: not allowed, it sorts the values itself)
 //! series = "method"                # optional (default method): one colour per value
 //! facet = "model"                  # optional: one small chart per value, all in one SVG
@@ -44,6 +46,7 @@
 //! x_log = false                    # optional log axes (default false)
 //! y_log = false
 //! y_range = [0.5, 3.2]             # optional y axis range (default: fits the data)
+//! view = [0, 0, 1]                 # sequence, corners: direction the model is seen from
 //!
 //! [quick]                          # what `--quick` runs: procedural models and assets/ only,
 //! models = ["assets/spot.obj"]     # done in seconds; caches, views and res override the
@@ -63,7 +66,7 @@ use serde::Deserialize;
 
 use super::row::{COLUMNS, METRICS, Needs};
 use crate::error::{Error, Result};
-use crate::mesh::procedural;
+use crate::mesh::{procedural, simplify};
 use crate::metrics::CacheModel;
 use crate::order::{self, METHODS};
 use crate::raster::{self, ViewSet};
@@ -123,6 +126,8 @@ pub struct Figure {
     pub x_log: bool,
     pub y_log: bool,
     pub y_range: Option<(f64, f64)>,
+    /// Drawing kinds: the direction the model is seen from (centre → eye), default +z.
+    pub view: [f32; 3],
 }
 
 /// The chart kinds `triorder plot` draws.
@@ -138,6 +143,22 @@ pub enum FigureKind {
     /// Every value of each series sorted ascending (a quantile curve) with its mean dashed, and
     /// mean, max and variance written in the chart: for per-view overdraw.
     Distribution,
+    /// A table of numbers: one row per x value, one column per series (the papers' tables).
+    Table,
+    /// Each (model, method) drawn as its triangles coloured by position in the sequence, with the
+    /// path through their centroids (Bogomjakov & Gotsman 2002, Figs. 2 and 4). Needs the
+    /// orders, which runs of drawing specs save next to the CSV.
+    Sequence,
+    /// Each (model, method, cache) drawn with every triangle corner coloured by whether its vertex
+    /// hit, was loaded the first time, or reloaded (Bogomjakov & Gotsman 2002, Figs. 10 and 11).
+    Corners,
+}
+
+impl FigureKind {
+    /// Kinds that draw the meshes themselves and so need the orders saved by the run.
+    pub fn draws_meshes(self) -> bool {
+        matches!(self, FigureKind::Sequence | FigureKind::Corners)
+    }
 }
 
 impl Spec {
@@ -160,6 +181,11 @@ impl Spec {
     /// `ROOT/results/ID.csv`, or `ROOT/results/quick/ID.csv` for quick runs.
     pub fn csv_path(&self, root: &Path, quick: bool) -> PathBuf {
         output_dir(root, "results", quick).join(format!("{}.csv", self.id))
+    }
+
+    /// `ROOT/results/ID.orders.csv` (or under `quick/`): the orders a drawing spec's figure draws.
+    pub fn orders_path(&self, root: &Path, quick: bool) -> PathBuf {
+        output_dir(root, "results", quick).join(format!("{}.orders.csv", self.id))
     }
 
     /// `ROOT/paper-figures/ID.svg`, or `ROOT/paper-figures/quick/ID.svg` for quick runs.
@@ -242,6 +268,7 @@ struct RawFigure {
     #[serde(default)]
     y_log: bool,
     y_range: Option<[f64; 2]>,
+    view: Option<[f32; 3]>,
 }
 
 #[derive(Deserialize)]
@@ -310,6 +337,7 @@ impl RawSpec {
 
 /// True for models a fresh clone has: procedural specs and the bundled `assets/` files.
 fn is_bundled(model: &str) -> bool {
+    let model = simplify::parse_source(model).map_or(model, |(base, _)| base);
     model.starts_with("assets/") || procedural::check(model).is_some()
 }
 
@@ -409,7 +437,25 @@ impl RawFigure {
                 Err(format!("{key} `{name}` is not a CSV column (columns: {})", COLUMNS.join(", ")))
             }
         };
+        let view = match (self.kind.draws_meshes(), self.view) {
+            (false, Some(_)) => return Err("figure.view is only for kind = \"sequence\" or \"corners\"".into()),
+            (true, Some(v)) if !(v.iter().all(|c| c.is_finite()) && v.iter().any(|&c| c != 0.0)) => {
+                return Err(format!("figure.view = {v:?} must be a finite, non-zero direction"));
+            }
+            (_, v) => v.unwrap_or([0.0, 0.0, 1.0]),
+        };
+        if self.kind.draws_meshes() && metric.name != "acmr" {
+            return Err(format!(
+                "figure.metric = \"{}\": kind = \"{}\" writes each drawing's ACMR, so metric must be \"acmr\"",
+                self.metric,
+                kind_name(self.kind)
+            ));
+        }
         match (self.kind, &self.x) {
+            (k, Some(_)) if k.draws_meshes() => {
+                return Err(format!("figure.x is not used by kind = \"{}\": remove it", kind_name(k)));
+            }
+            (k, None) if k.draws_meshes() => {}
             (FigureKind::Distribution, Some(_)) => {
                 return Err(
                     "figure.x is not used by kind = \"distribution\" (it sorts the values itself): remove it".into()
@@ -418,6 +464,9 @@ impl RawFigure {
             (FigureKind::Distribution, None) => {}
             (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
             (_, Some(x)) => column("figure.x", x)?,
+        }
+        if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.draws_meshes()) {
+            return Err(format!("figure.x_log / y_log: kind = \"{}\" has no axes", kind_name(self.kind)));
         }
         if self.x_log && matches!(self.kind, FigureKind::Bar | FigureKind::Distribution) {
             return Err(format!("figure.x_log: kind = \"{}\" has no numeric x axis", kind_name(self.kind)));
@@ -459,6 +508,7 @@ impl RawFigure {
             x_log: self.x_log,
             y_log: self.y_log,
             y_range,
+            view,
         })
     }
 }
@@ -469,6 +519,9 @@ fn kind_name(kind: FigureKind) -> &'static str {
         FigureKind::Scatter => "scatter",
         FigureKind::Bar => "bar",
         FigureKind::Distribution => "distribution",
+        FigureKind::Table => "table",
+        FigureKind::Sequence => "sequence",
+        FigureKind::Corners => "corners",
     }
 }
 

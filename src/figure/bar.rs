@@ -17,9 +17,9 @@ const MIN_LABELLED_BAR: i32 = 30;
 
 /// Values per panel, per series (in legend order), per category.
 pub struct Bars {
-    categories: Vec<String>,
-    series: Vec<String>,
-    values: Vec<Vec<Vec<Option<f64>>>>,
+    pub categories: Vec<String>,
+    pub series: Vec<String>,
+    pub values: Vec<Vec<Vec<Option<f64>>>>,
 }
 
 impl Bars {

@@ -57,6 +57,32 @@ impl Table {
         })
     }
 
+    /// The value of the one `metric` row whose columns equal `matches`; no such row, or several,
+    /// is an error naming the CSV (the results are stale or the spec changed).
+    pub fn value(&self, metric: &str, matches: &[(&str, &str)]) -> Result<f64> {
+        let metric_col = self.column("metric")?;
+        let value_col = self.column("value")?;
+        let columns = matches.iter().map(|(c, v)| Ok((self.column(c)?, *v))).collect::<Result<Vec<_>>>()?;
+        let mut found = self
+            .records
+            .iter()
+            .filter(|r| &r[metric_col] == metric && columns.iter().all(|&(c, v)| &r[c] == v))
+            .map(|r| &r[value_col]);
+        let describe = || matches.iter().map(|(c, v)| format!("{c} = {v}")).collect::<Vec<_>>().join(", ");
+        match (found.next(), found.next()) {
+            (Some(text), None) => text.parse().map_err(|_| {
+                Error::input(self.path.display(), format!("`{metric}` at {}: `{text}` is not a number", describe()))
+            }),
+            (None, _) => Err(Error::input(
+                self.path.display(),
+                format!("has no `{metric}` row at {}; rerun the experiment", describe()),
+            )),
+            (Some(_), Some(_)) => {
+                Err(Error::input(self.path.display(), format!("has several `{metric}` rows at {}", describe())))
+            }
+        }
+    }
+
     /// The distinct non-empty combinations of `columns` (missing columns: none), in order.
     pub fn distinct(&self, columns: &[&str]) -> Vec<Vec<String>> {
         let Ok(indices) = columns.iter().map(|c| self.column(c)).collect::<Result<Vec<_>>>() else {
@@ -118,7 +144,8 @@ impl Table {
                 }
             };
             let x = x.map_or(String::new(), |c| record[c].to_string());
-            if matches!(figure.kind, FigureKind::Line | FigureKind::Bar) && series.points.iter().any(|(px, _)| *px == x)
+            if matches!(figure.kind, FigureKind::Line | FigureKind::Bar | FigureKind::Table)
+                && series.points.iter().any(|(px, _)| *px == x)
             {
                 return Err(Error::input(
                     self.path.display(),

@@ -11,6 +11,8 @@ mod axes;
 mod bar;
 mod data;
 mod distribution;
+mod drawing;
+mod table;
 mod xy;
 
 use std::ops::Range;
@@ -32,11 +34,14 @@ pub struct PlotOptions {
     pub quick: bool,
     /// The project root holding `results/` and `paper-figures/`.
     pub out_dir: PathBuf,
+    /// Where drawing figures (kinds `sequence`, `corners`) find the models' geometry: as for runs,
+    /// else `TRIORDER_DATA`, else `../shared/data`.
+    pub data: Option<PathBuf>,
 }
 
 impl Default for PlotOptions {
     fn default() -> Self {
-        PlotOptions { quick: false, out_dir: PathBuf::from(".") }
+        PlotOptions { quick: false, out_dir: PathBuf::from("."), data: None }
     }
 }
 
@@ -66,6 +71,8 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
         }
         FigureKind::Bar => Box::new(bar::Bars::new(&panels)),
         FigureKind::Distribution => Box::new(distribution::Distribution::new(&panels)),
+        FigureKind::Table => Box::new(table::Tables(bar::Bars::new(&panels))),
+        FigureKind::Sequence | FigureKind::Corners => return drawing::plot(spec, opts, &table),
     };
     let frame = frame(kind.as_ref(), figure, &csv)?;
     let mut names: Vec<String> = Vec::new();
@@ -92,6 +99,14 @@ trait Kind {
     /// The extent of the data over all panels (panels share axes).
     fn extent(&self) -> Extent;
     fn swatch(&self) -> Swatch;
+    /// Whether the figure needs a colour legend (tables name their columns themselves).
+    fn legend(&self) -> bool {
+        true
+    }
+    /// The size of one panel, when the kind needs its own (tables grow with their rows).
+    fn panel_size(&self) -> Option<(usize, usize)> {
+        None
+    }
     /// Draws panel `index` into `area`.
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult;
 }
@@ -208,38 +223,64 @@ fn draw(
         _ => 3,
     };
     let rows = n.div_ceil(cols);
-    let (panel_w, panel_h) = if n == 1 { (760, 500) } else { (540, 400) };
+    let (panel_w, panel_h) = kind.panel_size().unwrap_or(if n == 1 { (760, 500) } else { (540, 400) });
     let width = (cols * panel_w) as u32;
-    let chars = |size: f64| (f64::from(width - 40) / (size * 0.55)) as usize;
-    let title = axes::wrap(&spec.title, chars(20.0));
-    let setup = axes::wrap(setup, chars(13.0));
-    let claim = spec.claim.as_deref().map_or_else(Vec::new, |c| axes::wrap(&format!("Paper: {c}"), chars(13.0)));
-    let header_h = 16 + 28 * title.len() as u32 + 18 * (setup.len() + claim.len()) as u32 + 10;
-    let legend_h = axes::legend_height(colors.entries(), width);
-    let height = header_h + (rows * panel_h) as u32 + legend_h;
+    let header = Header::new(spec, setup, width);
+    let legend_h = if kind.legend() { axes::legend_height(colors.entries(), width) } else { 0 };
+    let height = header.height + (rows * panel_h) as u32 + legend_h;
 
     let root = SVGBackend::with_string(svg, (width, height)).into_drawing_area();
     root.fill(&WHITE)?;
-    let (header, rest) = root.split_vertically(header_h);
+    let (top, rest) = root.split_vertically(header.height);
     let (body, legend) = rest.split_vertically((rows * panel_h) as u32);
-
-    let center = Pos::new(HPos::Center, VPos::Top);
-    let title_style = TextStyle::from((FONT, 20).into_font().style(FontStyle::Bold)).pos(center);
-    let grey = RGBColor(0x44, 0x44, 0x44);
-    let setup_style = TextStyle::from((FONT, 13)).color(&grey).pos(center);
-    let claim_style = TextStyle::from((FONT, 13).into_font().style(FontStyle::Italic)).color(&grey).pos(center);
-    let mut y = 16;
-    for line in &title {
-        header.draw_text(line, &title_style, (width as i32 / 2, y))?;
-        y += 28;
-    }
-    for (line, style) in setup.iter().map(|l| (l, &setup_style)).chain(claim.iter().map(|l| (l, &claim_style))) {
-        header.draw_text(line, style, (width as i32 / 2, y))?;
-        y += 18;
-    }
+    header.draw(&top)?;
     for (i, (area, panel)) in body.split_evenly((rows, cols)).iter().zip(panels).enumerate() {
         kind.draw(i, area, &panel.title, frame, colors)?;
     }
-    axes::legend(&legend, colors.entries(), kind.swatch())?;
+    if kind.legend() {
+        axes::legend(&legend, colors.entries(), kind.swatch())?;
+    }
     root.present()
+}
+
+/// A figure's header: its title, how the data was measured, and the paper's claim, wrapped to
+/// the figure's width.
+struct Header {
+    width: u32,
+    title: Vec<String>,
+    setup: Vec<String>,
+    claim: Vec<String>,
+    /// Pixels it takes.
+    height: u32,
+}
+
+impl Header {
+    fn new(spec: &Spec, setup: &str, width: u32) -> Header {
+        let chars = |size: f64| (f64::from(width - 40) / (size * 0.55)) as usize;
+        let title = axes::wrap(&spec.title, chars(20.0));
+        let setup = axes::wrap(setup, chars(13.0));
+        let claim = spec.claim.as_deref().map_or_else(Vec::new, |c| axes::wrap(&format!("Paper: {c}"), chars(13.0)));
+        let height = 16 + 28 * title.len() as u32 + 18 * (setup.len() + claim.len()) as u32 + 10;
+        Header { width, title, setup, claim, height }
+    }
+
+    fn draw(&self, area: &Area) -> DrawResult {
+        let center = Pos::new(HPos::Center, VPos::Top);
+        let title_style = TextStyle::from((FONT, 20).into_font().style(FontStyle::Bold)).pos(center);
+        let grey = RGBColor(0x44, 0x44, 0x44);
+        let setup_style = TextStyle::from((FONT, 13)).color(&grey).pos(center);
+        let claim_style = TextStyle::from((FONT, 13).into_font().style(FontStyle::Italic)).color(&grey).pos(center);
+        let mid = self.width as i32 / 2;
+        let mut y = 16;
+        for line in &self.title {
+            area.draw_text(line, &title_style, (mid, y))?;
+            y += 28;
+        }
+        let lines = self.setup.iter().map(|l| (l, &setup_style)).chain(self.claim.iter().map(|l| (l, &claim_style)));
+        for (line, style) in lines {
+            area.draw_text(line, style, (mid, y))?;
+            y += 18;
+        }
+        Ok(())
+    }
 }

@@ -13,6 +13,7 @@ pub mod ply;
 pub mod procedural;
 pub mod report;
 pub mod save;
+pub mod simplify;
 pub mod source;
 
 use glam::Vec3;
@@ -147,6 +148,24 @@ impl Mesh {
                     .collect(),
             },
         }
+    }
+}
+
+impl Mesh {
+    /// The mesh without the vertices no triangle uses, the rest numbered in order of first use
+    /// (what a simplifier's output needs before vertex counts mean anything).
+    pub fn without_unused_vertices(&self) -> Mesh {
+        let mut seen = vec![false; self.vertex_count()];
+        self.triangles.iter().flatten().for_each(|&v| seen[v as usize] = true);
+        let used = seen.iter().filter(|&&s| s).count();
+        let mut mesh = self.remap_vertices_first_use();
+        mesh.positions.truncate(used);
+        let a = &mut mesh.attributes;
+        a.normals.iter_mut().for_each(|v| v.truncate(used));
+        a.uvs.iter_mut().for_each(|v| v.truncate(used));
+        a.colors.iter_mut().for_each(|v| v.truncate(used));
+        a.extra.iter_mut().for_each(|e| e.values.truncate(used));
+        mesh
     }
 }
 

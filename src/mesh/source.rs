@@ -1,4 +1,5 @@
-//! Naming meshes: a procedural spec (`grid:16x8`), a path, or a path inside the data directory.
+//! Naming meshes: a procedural spec (`grid:16x8`), a path, or a path inside the data directory,
+//! optionally simplified to N triangles with an `@N` suffix (`models/bun_zipper.ply@20000`).
 //!
 //! Experiments name models relative to a data directory (`models/bunny_2k.ply`) so the same spec
 //! works for every user. The data directory is `--data DIR`, else `$TRIORDER_DATA`, else
@@ -8,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, load, procedural};
+use crate::mesh::{Mesh, load, procedural, simplify};
 
 /// The directory models are looked up in, if any.
 pub fn data_dir(explicit: Option<&Path>) -> Option<PathBuf> {
@@ -25,6 +26,10 @@ pub fn data_dir(explicit: Option<&Path>) -> Option<PathBuf> {
 /// Loads `source`: a procedural spec, an existing path, or a path relative to `data`.
 /// `seed` drives seeded generators (`disk:N`).
 pub fn open(source: &str, data: Option<&Path>, seed: u64) -> Result<Mesh> {
+    if let Some((base, count)) = simplify::parse_source(source) {
+        let target = simplify::parse_target(source, count)?;
+        return simplify::simplify(&open(base, data, seed)?, target);
+    }
     match procedural::generate(source, seed) {
         Some(generated) => generated,
         None => load::load_file(&locate_file(source, data)?),
@@ -34,6 +39,10 @@ pub fn open(source: &str, data: Option<&Path>, seed: u64) -> Result<Mesh> {
 /// Checks that `source` can be opened, without reading or generating it: a well-formed
 /// procedural spec, or a file that exists. Lets a long run fail before any work.
 pub fn check(source: &str, data: Option<&Path>) -> Result<()> {
+    if let Some((base, count)) = simplify::parse_source(source) {
+        simplify::parse_target(source, count)?;
+        return check(base, data);
+    }
     match procedural::check(source) {
         Some(checked) => checked,
         None => locate_file(source, data).map(drop),

@@ -119,25 +119,57 @@ impl CacheStats {
 
 /// Simulates `model` over `triangles` (already in draw order) whose indices are < `vertex_count`.
 pub fn simulate(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+    run(model, triangles, vertex_count, |_| {})
+}
+
+/// What happened at one corner (a triangle's use of a vertex) in a simulation: the picture of
+/// Bogomjakov & Gotsman 2002, Figs. 10 and 11, where each corner is coloured by the misses of its
+/// vertex. `Miss(1)` is the vertex's first load (every referenced vertex has exactly one), `Miss(n)`
+/// its (n−1)-th reload; a reload is the waste an ordering is judged by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Corner {
+    Hit,
+    /// The n-th time this vertex is transformed (saturating at 255).
+    Miss(u8),
+}
+
+/// Simulates `model` and classifies every corner: `result[t][c]` is corner `c` of the `t`-th
+/// triangle drawn. Counts agree with [`simulate`] (the same simulators run).
+pub fn corners(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize) -> (CacheStats, Vec<[Corner; 3]>) {
+    let mut classes = vec![[Corner::Hit; 3]; triangles.len()];
+    let mut loads = vec![0u8; vertex_count];
+    let stats = run(model, triangles, vertex_count, |corner| {
+        let (t, c) = (corner / 3, corner % 3);
+        let n = &mut loads[triangles[t][c] as usize];
+        *n = n.saturating_add(1);
+        classes[t][c] = Corner::Miss(*n);
+    });
+    (stats, classes)
+}
+
+/// Runs the simulator of `model`, calling `on_miss(3·t + c)` for each missing corner `c` of the
+/// `t`-th triangle (a no-op closure compiles away, so [`simulate`] pays nothing for it).
+fn run(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize, on_miss: impl FnMut(usize)) -> CacheStats {
     match model {
-        CacheModel::Fifo(k) => fifo(k, triangles, vertex_count),
-        CacheModel::Lru(k) => lru(k, triangles, vertex_count),
-        CacheModel::Batch { cache, warp, primgroup } => batch(cache, warp, primgroup, triangles, vertex_count),
+        CacheModel::Fifo(k) => fifo(k, triangles, vertex_count, on_miss),
+        CacheModel::Lru(k) => lru(k, triangles, vertex_count, on_miss),
+        CacheModel::Batch { cache, warp, primgroup } => batch(cache, warp, primgroup, triangles, vertex_count, on_miss),
     }
 }
 
 /// FIFO by timestamps: `stamp[v]` is the miss count when v last entered; v is cached iff fewer
 /// than k misses happened since. Stamps start at k+1 so an untouched vertex (stamp 0) misses, and
 /// a non-zero stamp marks a referenced vertex.
-fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize, mut on_miss: impl FnMut(usize)) -> CacheStats {
     let mut stamp = vec![0u32; vertex_count];
     let mut now = k + 1;
-    for tri in triangles {
-        for &v in tri {
+    for (t, tri) in triangles.iter().enumerate() {
+        for (c, &v) in tri.iter().enumerate() {
             let s = &mut stamp[v as usize];
             if now - *s > k {
                 *s = now;
                 now += 1;
+                on_miss(3 * t + c);
             }
         }
     }
@@ -154,7 +186,14 @@ fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
 /// triangles, or its vertices plus those missing corners would exceed `warp`, the batch is
 /// submitted and the cache emptied. A repeated corner counts once per corner in that test, as
 /// there.
-fn batch(k: u32, warp: u32, primgroup: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+fn batch(
+    k: u32,
+    warp: u32,
+    primgroup: u32,
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    mut on_miss: impl FnMut(usize),
+) -> CacheStats {
     // A disabled limit becomes one no batch can reach, which keeps the loop free of extra tests.
     let off_is_max = |limit: u32| if limit == 0 { u32::MAX } else { limit };
     let (warp, primgroup) = (off_is_max(warp), off_is_max(primgroup));
@@ -162,7 +201,7 @@ fn batch(k: u32, warp: u32, primgroup: u32, triangles: &[[u32; 3]], vertex_count
     let mut now = k + 1;
     let (mut misses, mut batches) = (0u64, 0u64);
     let (mut in_warp, mut in_group) = (0u32, 0u32);
-    for tri in triangles {
+    for (t, tri) in triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|v| v as usize);
         let missing = u32::from(now - stamp[a] > k) + u32::from(now - stamp[b] > k) + u32::from(now - stamp[c] > k);
         if in_group == primgroup || in_warp.saturating_add(missing) > warp {
@@ -171,12 +210,13 @@ fn batch(k: u32, warp: u32, primgroup: u32, triangles: &[[u32; 3]], vertex_count
             in_group = 0;
             now += k + 1;
         }
-        for v in [a, b, c] {
+        for (corner, v) in [a, b, c].into_iter().enumerate() {
             if now - stamp[v] > k {
                 stamp[v] = now;
                 now += 1;
                 misses += 1;
                 in_warp += 1;
+                on_miss(3 * t + corner);
             }
         }
         in_group += 1;
@@ -187,7 +227,7 @@ fn batch(k: u32, warp: u32, primgroup: u32, triangles: &[[u32; 3]], vertex_count
 
 /// LRU as an intrusive doubly linked list over vertex ids (front = most recent), so a hit's
 /// move-to-front and a miss's eviction are O(1) whatever the cache size.
-fn lru(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
+fn lru(k: u32, triangles: &[[u32; 3]], vertex_count: usize, mut on_miss: impl FnMut(usize)) -> CacheStats {
     const NIL: u32 = u32::MAX;
     let mut prev = vec![NIL; vertex_count];
     let mut next = vec![NIL; vertex_count];
@@ -195,8 +235,8 @@ fn lru(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
     let mut referenced = vec![false; vertex_count];
     let (mut head, mut tail, mut len) = (NIL, NIL, 0u32);
     let mut misses = 0u64;
-    for tri in triangles {
-        for &v in tri {
+    for (t, tri) in triangles.iter().enumerate() {
+        for (c, &v) in tri.iter().enumerate() {
             let vi = v as usize;
             if cached[vi] {
                 if head == v {
@@ -212,6 +252,7 @@ fn lru(k: u32, triangles: &[[u32; 3]], vertex_count: usize) -> CacheStats {
                 }
             } else {
                 misses += 1;
+                on_miss(3 * t + c);
                 referenced[vi] = true;
                 cached[vi] = true;
                 len += 1;
@@ -280,6 +321,34 @@ mod tests {
         // LRU by hand: the one extra hit is vertex 4 at triangle 4, refreshed by triangle 3.
         assert_eq!(misses("lru:4", &tris, 14), 24);
         assert_eq!(misses("lru:16", &tris, 14), 14);
+    }
+
+    #[test]
+    fn corners_classify_every_miss() {
+        let tris: Vec<_> = FIG1.iter().map(|t| t.map(|v| v - 1)).collect();
+        for model in ["fifo:4", "lru:4", "batch:4,6,3", "fifo:16"] {
+            let model: CacheModel = model.parse().unwrap();
+            let (stats, classes) = corners(model, &tris, 14);
+            assert_eq!(stats, simulate(model, &tris, 14));
+            let missed = classes.iter().flatten().filter(|c| **c != Corner::Hit).count();
+            assert_eq!(missed as u64, stats.misses, "{model}");
+            // Every vertex has exactly one first load (Bogomjakov & Gotsman Fig. 10's green corner).
+            let mut first = [0; 14];
+            for (tri, cls) in tris.iter().zip(&classes) {
+                for (&v, c) in tri.iter().zip(cls) {
+                    first[v as usize] += usize::from(*c == Corner::Miss(1));
+                }
+            }
+            assert_eq!(first, [1; 14], "{model}");
+        }
+        // Fig. 1 at FIFO-4 by hand: after (1,2,4), (1,4,5), (4,5,14) the cache holds 2,4,5,14 (1
+        // evicted by 14); (2,3,4) then hits 4, loads 3 first, and 2, still cached, is a hit; 3 evicts
+        // 2. Triangle 5 (3,4,12) hits 3 and 4 and loads 12, evicting 4.
+        let (_, classes) = corners(CacheModel::Fifo(4), &tris, 14);
+        assert_eq!(classes[0], [Corner::Miss(1); 3]);
+        assert_eq!(classes[1], [Corner::Hit, Corner::Hit, Corner::Miss(1)]);
+        assert_eq!(classes[3], [Corner::Hit, Corner::Miss(1), Corner::Hit]);
+        assert_eq!(classes[4], [Corner::Hit, Corner::Hit, Corner::Miss(1)]);
     }
 
     #[test]

@@ -4,5 +4,5 @@
 pub mod cache;
 pub mod overdraw;
 
-pub use cache::{CacheModel, CacheStats};
+pub use cache::{CacheModel, CacheStats, Corner};
 pub use overdraw::OverdrawSummary;

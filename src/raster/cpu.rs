@@ -66,11 +66,25 @@ impl RasterBackend for CpuRaster {
                 || (Vec::new(), Vec::new()),
                 |(screen, depth), (i, camera)| {
                     project(positions, camera, res, screen).map_err(|why| Error::usage(format!("view {i}: {why}")))?;
-                    Ok(draw(screen, triangles, res, depth))
+                    Ok(draw(screen, triangles, res, depth, |_, _| {}))
                 },
             )
             .collect()
     }
+}
+
+/// The triangle seen at each pixel (row-major, row 0 at the bottom), `u32::MAX` where none: the
+/// index into `triangles` of the last fragment to pass the depth test there, under exactly the
+/// rules [`CpuRaster`] counts by. Figures use it to draw a mesh as the measurements see it.
+pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Camera, res: u32) -> Result<Vec<u32>> {
+    if !(1..=MAX_RESOLUTION).contains(&res) {
+        return Err(Error::usage(format!("resolution {res} is outside 1..={MAX_RESOLUTION}")));
+    }
+    let mut screen = Vec::new();
+    project(positions, camera, res, &mut screen).map_err(Error::usage)?;
+    let mut seen = vec![u32::MAX; res as usize * res as usize];
+    draw(&screen, triangles, res, &mut Vec::new(), |pixel, t| seen[pixel] = t as u32);
+    Ok(seen)
 }
 
 /// Projects and snaps every vertex into `out`. Fails if a vertex lies outside the depth range
@@ -120,14 +134,21 @@ impl Edge {
     }
 }
 
-/// Draws `triangles` in order into a cleared depth buffer and counts.
-fn draw(v: &[ScreenVertex], triangles: &[[u32; 3]], res: u32, depth: &mut Vec<f32>) -> ViewCounts {
+/// Draws `triangles` in order into a cleared depth buffer and counts; `on_pass(pixel, t)` sees
+/// each fragment of the `t`-th triangle that passes the depth test (a no-op closure compiles away).
+fn draw(
+    v: &[ScreenVertex],
+    triangles: &[[u32; 3]],
+    res: u32,
+    depth: &mut Vec<f32>,
+    mut on_pass: impl FnMut(usize, usize),
+) -> ViewCounts {
     let n = res as usize;
     depth.clear();
     depth.resize(n * n, 1.0);
     let mut counts = ViewCounts::default();
     let last = i64::from(res) - 1;
-    for tri in triangles {
+    for (t, tri) in triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|i| v[i as usize]);
         // Pixel index range whose centres (i·ONE + HALF) can lie inside the bounding box; most
         // triangles of a dense mesh cover no centre and stop here.
@@ -166,6 +187,7 @@ fn draw(v: &[ScreenVertex], triangles: &[[u32; 3]], res: u32, depth: &mut Vec<f3
                         counts.covered += u64::from(*d == 1.0);
                         *d = z;
                         counts.passed += 1;
+                        on_pass(row + x as usize, t);
                     }
                 }
                 e0 += edges[0].step_x;

@@ -1,0 +1,388 @@
+//! Drawings of meshes in their draw order, the pictures Bogomjakov & Gotsman 2002 explain their
+//! orderings with:
+//! - `sequence` (their Figs. 2 and 4): triangles coloured by position in the sequence, the path
+//!   through consecutive centroids drawn thick where the two triangles share an edge and thin
+//!   where the sequence jumps. Vector graphics: meant for meshes of a few thousand triangles.
+//! - `corners` (their Figs. 10 and 11): every triangle corner coloured by what the cache did when
+//!   that triangle used the corner's vertex — hit, first load, first reload, later reload. The
+//!   paper codes "the number of cache misses for the corner's vertex" with green for the one
+//!   first load each vertex has and blue and red for reloads; we read blue as the first reload and
+//!   red as any later one. Drawn as the CPU rasterizer sees the mesh (the visible triangle at each
+//!   pixel, same rules as the overdraw counts) into an image embedded in the SVG, so a mesh of any
+//!   size stays legible and small on disk.
+//!
+//! The orders come from the run's orders file and the models' geometry from the data directory;
+//! the ACMR in each title is the results CSV's, and `corners` checks it against the corner counts
+//! it draws, so a figure can never silently show stale orders.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use glam::{Vec2, Vec3};
+use plotters::prelude::*;
+
+use super::axes::{self, DrawResult, FONT};
+use super::data::Table;
+use super::{Header, PlotOptions};
+use crate::error::{Error, Result};
+use crate::experiment::row::OrderRow;
+use crate::experiment::spec::{FigureKind, Spec};
+use crate::mesh::{Mesh, source};
+use crate::metrics::{CacheModel, Corner, cache};
+use crate::order;
+use crate::raster::{Framing, cpu, views};
+use crate::topology::Topology;
+
+/// Panel width in pixels; the mesh fills it less a margin, at its own aspect ratio.
+const PANEL_W: u32 = 520;
+const MARGIN: u32 = 10;
+const TITLE_H: u32 = 44;
+const LEGEND_H: u32 = 40;
+/// Corner images are rendered at this many pixels per SVG pixel, so zooming in stays sharp.
+const OVERSAMPLE: f32 = 2.0;
+
+/// Corner colours: hit, first load, first reload, later reloads.
+const HIT: [u8; 3] = [200, 200, 200];
+const FIRST_LOAD: [u8; 3] = [40, 165, 70];
+const RELOAD: [u8; 3] = [45, 100, 220];
+const LATER_RELOAD: [u8; 3] = [220, 40, 40];
+
+/// One panel: a model drawn in one method's order (and, for corners, under one cache).
+struct Drawing<'a> {
+    mesh: &'a Mesh,
+    title: String,
+    /// Triangles in draw order.
+    triangles: Vec<[u32; 3]>,
+    kind: Content,
+}
+
+enum Content {
+    /// Consecutive triangles that share an edge (`adjacent[i]`: triangle i and i + 1).
+    Sequence { adjacent: Vec<bool> },
+    /// The class of each corner of each drawn triangle.
+    Corners(Vec<[Corner; 3]>),
+}
+
+/// Draws a drawing spec's figure (kind `sequence` or `corners`); returns the SVG's path.
+pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
+    let work = spec.workload(opts.quick)?;
+    let orders_path = spec.orders_path(&opts.out_dir, opts.quick);
+    let orders = read_orders(&orders_path)?;
+    let data = source::data_dir(opts.data.as_deref());
+    let meshes = work.models.iter().map(|m| source::open(m, data.as_deref(), spec.seed)).collect::<Result<Vec<_>>>()?;
+
+    let stale = |what: String| Error::input(orders_path.display(), format!("{what}; rerun the experiment"));
+    let mut drawings = Vec::new();
+    for (model, mesh) in work.models.iter().zip(&meshes) {
+        let label = if work.models.len() > 1 { format!("{}: ", short(model)) } else { String::new() };
+        let topology = (spec.figure.kind == FigureKind::Sequence).then(|| Topology::new(mesh));
+        for method in &spec.methods {
+            let order = orders
+                .get(&(model.clone(), method.clone()))
+                .ok_or_else(|| stale(format!("has no order for `{method}` on `{model}`")))?;
+            order::check_permutation(order, mesh.triangle_count())
+                .map_err(|why| stale(format!("`{method}` on `{model}` is not an order of this model ({why})")))?;
+            let triangles = mesh.triangles_in_order(order);
+            let acmr = |cache: &CacheModel| {
+                table.value("acmr", &[("model", model), ("method", method), ("cache", &cache.to_string())])
+            };
+            let name = method.split(':').next().unwrap_or(method);
+            match &topology {
+                Some(topology) => {
+                    let mut numbers = Vec::new();
+                    for cache in &work.caches {
+                        numbers.push(format!("{} {}", cache, axes::number(acmr(cache)?)));
+                    }
+                    let adjacent =
+                        order.windows(2).map(|w| topology.neighbors.row(w[0] as usize).contains(&w[1])).collect();
+                    drawings.push(Drawing {
+                        mesh,
+                        title: format!("{label}{name} · ACMR {}", numbers.join(", ")),
+                        triangles,
+                        kind: Content::Sequence { adjacent },
+                    });
+                }
+                None => {
+                    for cache in &work.caches {
+                        let (stats, classes) = cache::corners(*cache, &triangles, mesh.vertex_count());
+                        let recorded = acmr(cache)?;
+                        if (stats.acmr() - recorded).abs() > 1e-9 * recorded.max(1.0) {
+                            return Err(stale(format!(
+                                "`{method}` on `{model}` gives ACMR {} at {cache}, the results say {recorded}",
+                                stats.acmr()
+                            )));
+                        }
+                        drawings.push(Drawing {
+                            mesh,
+                            title: format!("{label}{name} · {cache} · ACMR {}", axes::number(recorded)),
+                            triangles: triangles.clone(),
+                            kind: Content::Corners(classes),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    let path = spec.svg_path(&opts.out_dir, opts.quick);
+    let svg = render(spec, opts.quick, &drawings).map_err(|e| Error::output(&path, format!("cannot draw: {e}")))?;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output(&path, e))?;
+    }
+    crate::atomic::write(&path, svg.as_bytes())?;
+    Ok(path)
+}
+
+/// `models/horse.ply@40000` → `horse.ply@40000`.
+fn short(model: &str) -> &str {
+    model.rsplit('/').next().unwrap_or(model)
+}
+
+/// The orders file, by (model, method), each in position order.
+fn read_orders(path: &Path) -> Result<HashMap<(String, String), Vec<u32>>> {
+    let mut reader = csv::Reader::from_path(path).map_err(|e| {
+        Error::input(
+            path.display(),
+            format!("cannot read the orders ({e}); run the experiment first (`triorder run SPEC`)"),
+        )
+    })?;
+    let mut orders: HashMap<(String, String), Vec<u32>> = HashMap::new();
+    for (i, row) in reader.deserialize::<OrderRow>().enumerate() {
+        let row = row.map_err(|e| Error::input(path.display(), format!("line {}: {e}", i + 2)))?;
+        let order = orders.entry((row.model, row.method)).or_default();
+        if row.position != order.len() {
+            return Err(Error::input(
+                path.display(),
+                format!("line {}: position {} out of sequence", i + 2, row.position),
+            ));
+        }
+        order.push(row.triangle);
+    }
+    Ok(orders)
+}
+
+/// Where a drawing's mesh lands: the orthographic projection of the spec's view, its bounding
+/// box in normalised device coordinates, and the panel rectangle it maps to.
+struct Placement {
+    camera: views::Camera,
+    lo: Vec2,
+    hi: Vec2,
+    width: u32,
+    height: u32,
+}
+
+impl Placement {
+    fn new(mesh: &Mesh, view: [f32; 3]) -> Placement {
+        let camera = views::orthographic(Framing::of(&mesh.positions), Vec3::from(view).normalize());
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for &p in &mesh.positions {
+            let q = ndc(&camera, p);
+            (lo, hi) = (lo.min(q), hi.max(q));
+        }
+        let size = (hi - lo).max(Vec2::splat(1e-6));
+        let width = PANEL_W - 2 * MARGIN;
+        let height = ((width as f32 * size.y / size.x).round() as u32).clamp(40, 2 * width);
+        Placement { camera, lo, hi, width, height }
+    }
+
+    /// Panel pixel (from the mesh rectangle's top left) of an NDC point.
+    fn pixel(&self, q: Vec2) -> (f32, f32) {
+        let t = (q - self.lo) / (self.hi - self.lo).max(Vec2::splat(1e-6));
+        (t.x * self.width as f32, (1.0 - t.y) * self.height as f32)
+    }
+}
+
+fn ndc(camera: &views::Camera, p: Vec3) -> Vec2 {
+    let clip = camera.view_proj * p.extend(1.0);
+    Vec2::new(clip.x / clip.w, clip.y / clip.w)
+}
+
+/// The whole SVG: header, panels in a grid, a legend line.
+fn render(spec: &Spec, quick: bool, drawings: &[Drawing]) -> std::result::Result<String, String> {
+    let placements: Vec<Placement> = drawings.iter().map(|d| Placement::new(d.mesh, spec.figure.view)).collect();
+    let cols = match drawings.len() {
+        1 => 1,
+        2 | 4 => 2,
+        _ => 3,
+    };
+    let row_h: Vec<u32> =
+        placements.chunks(cols).map(|row| TITLE_H + MARGIN + row.iter().map(|p| p.height).max().unwrap_or(0)).collect();
+    let width = cols as u32 * PANEL_W;
+    let setup = if quick { "quick run: small stand-in models, not the paper's" } else { "" };
+    let header = Header::new(spec, setup, width);
+    let height = header.height + row_h.iter().sum::<u32>() + LEGEND_H;
+
+    // Panel origins (top left of the title) in a grid, row heights fitting their tallest mesh.
+    let mut origins = Vec::with_capacity(drawings.len());
+    let mut top = header.height;
+    for h in &row_h {
+        for c in 0..cols {
+            if origins.len() < drawings.len() {
+                origins.push((c as u32 * PANEL_W, top));
+            }
+        }
+        top += h;
+    }
+    let mut images = String::new();
+    for ((drawing, place), &(left, top)) in drawings.iter().zip(&placements).zip(&origins) {
+        if let Content::Corners(classes) = &drawing.kind {
+            images.push_str(&corner_image(drawing, classes, place, (left + MARGIN, top + TITLE_H))?);
+        }
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        let draw = || -> DrawResult {
+            root.fill(&WHITE)?;
+            header.draw(&root)?;
+            let title = (FONT, 14).into_text_style(&root);
+            for ((drawing, place), &(left, top)) in drawings.iter().zip(&placements).zip(&origins) {
+                for (k, line) in axes::wrap(&drawing.title, 60).iter().take(2).enumerate() {
+                    root.draw_text(line, &title, (left as i32 + 12, (top + 8 + 17 * k as u32) as i32))?;
+                }
+                if let Content::Sequence { adjacent } = &drawing.kind {
+                    sequence(&root, drawing, adjacent, place, (left + MARGIN, top + TITLE_H))?;
+                }
+            }
+            if let Some(first) = drawings.first() {
+                legend(&root, &first.kind, (height - LEGEND_H + 12) as i32)?;
+            }
+            root.present()
+        };
+        draw().map_err(|e| e.to_string())?;
+    }
+    let end = svg.rfind("</svg>").ok_or("the SVG backend wrote no closing tag")?;
+    svg.insert_str(end, &images);
+    Ok(svg)
+}
+
+/// Triangles coloured from red (first) to violet (last), then the path through their centroids.
+fn sequence(
+    root: &super::axes::Area,
+    drawing: &Drawing,
+    adjacent: &[bool],
+    place: &Placement,
+    (ox, oy): (u32, u32),
+) -> DrawResult {
+    let at = |p: Vec3| {
+        let (x, y) = place.pixel(ndc(&place.camera, p));
+        (ox as i32 + x.round() as i32, oy as i32 + y.round() as i32)
+    };
+    let n = drawing.triangles.len().max(2) as f64;
+    let mut centroids = Vec::with_capacity(drawing.triangles.len());
+    for (i, tri) in drawing.triangles.iter().enumerate() {
+        let corners = tri.map(|v| drawing.mesh.positions[v as usize]);
+        let color = HSLColor(0.8 * i as f64 / (n - 1.0), 0.7, 0.62);
+        root.draw(&Polygon::new(corners.iter().map(|&p| at(p)).collect::<Vec<_>>(), color.filled()))?;
+        root.draw(&PathElement::new(
+            [0, 1, 2, 0].iter().map(|&k| at(corners[k])).collect::<Vec<_>>(),
+            WHITE.stroke_width(1),
+        ))?;
+        centroids.push(at((corners[0] + corners[1] + corners[2]) / 3.0));
+    }
+    for (pair, &adjacent) in centroids.windows(2).zip(adjacent) {
+        let style = if adjacent { BLACK.stroke_width(2) } else { RGBColor(60, 60, 60).stroke_width(1) };
+        root.draw(&PathElement::new(vec![pair[0], pair[1]], style))?;
+    }
+    Ok(())
+}
+
+/// The corner picture as an `<image>` element: each visible pixel takes the colour of the corner
+/// of its triangle it lies nearest (largest barycentric weight), shaded by the facet's angle to
+/// the view, with triangle borders darkened.
+fn corner_image(
+    drawing: &Drawing,
+    classes: &[[Corner; 3]],
+    place: &Placement,
+    (ox, oy): (u32, u32),
+) -> std::result::Result<String, String> {
+    // The rasterizer draws the NDC square [-1, 1]²; choose its size so the mesh's box gets
+    // OVERSAMPLE pixels per SVG pixel, then crop to that box.
+    let span = (place.hi - place.lo).max(Vec2::splat(1e-6));
+    let res = ((OVERSAMPLE * place.width as f32 * 2.0 / span.x).ceil() as u32).clamp(16, cpu::MAX_RESOLUTION);
+    let ids = cpu::visible_triangles(&drawing.mesh.positions, &drawing.triangles, &place.camera, res)
+        .map_err(|e| e.to_string())?;
+    let to_px = |v: f32| ((v + 1.0) * 0.5 * res as f32).clamp(0.0, res as f32);
+    let (x0, x1) = (to_px(place.lo.x).floor() as usize, to_px(place.hi.x).ceil() as usize);
+    let (y0, y1) = (to_px(place.lo.y).floor() as usize, to_px(place.hi.y).ceil() as usize);
+    let (w, h) = (x1.saturating_sub(x0).max(1), y1.saturating_sub(y0).max(1));
+    let projected: Vec<Vec2> = drawing.mesh.positions.iter().map(|&p| ndc(&place.camera, p)).collect();
+    let n = res as usize;
+    let id = |x: usize, y: usize| if x < n && y < n { ids[y * n + x] } else { u32::MAX };
+    let mut rgb = vec![255u8; w * h * 3];
+    for row in 0..h {
+        let y = y1 - 1 - row; // image rows run top-down, raster rows bottom-up
+        for col in 0..w {
+            let x = x0 + col;
+            let t = id(x, y);
+            if t == u32::MAX {
+                continue;
+            }
+            let tri = drawing.triangles[t as usize];
+            let p = Vec2::new((x as f32 + 0.5) / res as f32 * 2.0 - 1.0, (y as f32 + 0.5) / res as f32 * 2.0 - 1.0);
+            let [a, b, c] = tri.map(|v| projected[v as usize]);
+            let area = (b - a).perp_dot(c - a);
+            let weights =
+                [(c - b).perp_dot(p - b) / area, (a - c).perp_dot(p - c) / area, (b - a).perp_dot(p - a) / area];
+            let corner = (0..3).max_by(|&i, &j| weights[i].total_cmp(&weights[j])).unwrap_or(0);
+            let base = match classes[t as usize][corner] {
+                Corner::Hit => HIT,
+                Corner::Miss(1) => FIRST_LOAD,
+                Corner::Miss(2) => RELOAD,
+                Corner::Miss(_) => LATER_RELOAD,
+            };
+            let [pa, pb, pc] = tri.map(|v| drawing.mesh.positions[v as usize]);
+            let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
+            let mut shade = 0.5 + 0.5 * normal.dot(-place.camera.forward).abs();
+            if id(x + 1, y) != t || id(x, y + 1) != t {
+                shade *= 0.6;
+            }
+            let out = &mut rgb[(row * w + col) * 3..][..3];
+            for k in 0..3 {
+                out[k] = (f32::from(base[k]) * shade).round() as u8;
+            }
+        }
+    }
+    let mut png_bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut png_bytes, w as u32, h as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::High);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&png_bytes);
+    Ok(format!(
+        "<image x=\"{ox}\" y=\"{oy}\" width=\"{}\" height=\"{}\" preserveAspectRatio=\"none\" href=\"data:image/png;base64,{data}\"/>\n",
+        place.width, place.height
+    ))
+}
+
+/// One line saying how to read the panels.
+fn legend(root: &super::axes::Area, kind: &Content, y: i32) -> DrawResult {
+    let style = (FONT, 13).into_text_style(root);
+    match kind {
+        Content::Sequence { .. } => root.draw_text(
+            "colour: position in the sequence, first (red) to last (violet) · thick line: consecutive triangles share an edge · thin line: a jump",
+            &style,
+            (12, y),
+        ),
+        Content::Corners(_) => {
+            let entries = [
+                (HIT, "hit"),
+                (FIRST_LOAD, "first load (one per vertex)"),
+                (RELOAD, "first reload"),
+                (LATER_RELOAD, "second or later reload"),
+            ];
+            let mut x = 12;
+            for (color, label) in entries {
+                let [r, g, b] = color;
+                root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], RGBColor(r, g, b).filled()))?;
+                root.draw_text(label, &style, (x + 20, y))?;
+                x += 44 + axes::text_width(label, 13.0) / 2;
+            }
+            Ok(())
+        }
+    }
+}

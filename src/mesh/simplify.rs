@@ -1,0 +1,56 @@
+//! Lower resolutions of a mesh, made by meshoptimizer's edge-collapse simplifier (the `meshopt`
+//! crate), for ACMR against mesh resolution (Bogomjakov & Gotsman 2002, Fig. 8b and 8d: every
+//! resolution is ordered from scratch). Their models' intermediate resolutions came from their
+//! own simplifier; ours differ in shape but not in what the figure asks, which is how an
+//! ordering's ACMR behaves as the triangle count falls.
+//!
+//! A model source `PATH@N` (e.g. `models/bun_zipper.ply@20000`) names the model at N triangles.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::peer;
+
+/// How far from the requested count a result may land: the simplifier collapses edges in
+/// batches, so it may pass the target by a few triangles, and stops short when no collapse is left.
+const TOLERANCE: f64 = 0.02;
+
+/// Splits `PATH@N` into the base source and the triangle count; `None` when `source` has no such
+/// suffix (an `@` followed by something other than digits is part of a file name).
+pub fn parse_source(source: &str) -> Option<(&str, &str)> {
+    let (base, count) = source.rsplit_once('@')?;
+    (!count.is_empty() && count.bytes().all(|b| b.is_ascii_digit())).then_some((base, count))
+}
+
+/// Checks the `N` of `PATH@N`: a positive triangle count.
+pub fn parse_target(source: &str, count: &str) -> Result<usize> {
+    match count.parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(Error::input(source, format!("`@{count}`: the target triangle count must be a positive integer"))),
+    }
+}
+
+/// `mesh` simplified to about `target` triangles (within 2%), unused vertices dropped and
+/// the rest numbered in order of first use. Attributes follow their vertices; the simplifier
+/// keeps attribute seams (vertices with equal positions but different attributes) in place.
+pub fn simplify(mesh: &Mesh, target: usize) -> Result<Mesh> {
+    let name = format!("{}@{target}", mesh.name);
+    if target >= mesh.triangle_count() {
+        return Err(Error::input(
+            &name,
+            format!("asks for {target} triangles but the model has only {}", mesh.triangle_count()),
+        ));
+    }
+    let indices = peer::index_buffer(mesh);
+    // Error limit 1.0 (the whole model's extent): the triangle count alone decides where to stop.
+    let simplified =
+        meshopt::simplify(&indices, &peer::positions(mesh), 3 * target, 1.0, meshopt::SimplifyOptions::None, None);
+    let reached = simplified.len() / 3;
+    if (reached as f64 - target as f64).abs() > target as f64 * TOLERANCE {
+        return Err(Error::input(
+            &name,
+            format!("the simplifier stopped at {reached} triangles, not within 2% of the {target} asked for"),
+        ));
+    }
+    let triangles: Vec<[u32; 3]> = simplified.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    Ok(Mesh { name, triangles, ..mesh.clone() }.without_unused_vertices())
+}
