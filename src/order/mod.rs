@@ -7,7 +7,9 @@
 
 pub mod params;
 
+mod hoppe;
 mod input;
+mod kcache;
 mod meshopt_fifo;
 mod meshopt_overdraw;
 mod meshopt_vcache;
@@ -48,8 +50,15 @@ pub struct Method {
 }
 
 /// Every method, in the order `triorder methods` lists them.
-pub static METHODS: &[&Method] =
-    &[&input::METHOD, &random::METHOD, &meshopt_vcache::METHOD, &meshopt_fifo::METHOD, &meshopt_overdraw::METHOD];
+pub static METHODS: &[&Method] = &[
+    &input::METHOD,
+    &random::METHOD,
+    &hoppe::METHOD,
+    &kcache::METHOD,
+    &meshopt_vcache::METHOD,
+    &meshopt_fifo::METHOD,
+    &meshopt_overdraw::METHOD,
+];
 
 /// A method spec resolved against the registry: ready to run, with its canonical name.
 pub struct Resolved {
