@@ -1,6 +1,7 @@
-//! The measurements: vertex-cache simulation ([`cache`]) and overdraw statistics over view sets
-//! ([`overdraw`]).
+//! The measurements: vertex-cache simulation ([`cache`]), overdraw statistics over view sets
+//! ([`overdraw`]) and linear-arrangement costs of an order ([`arrangement`]).
 
+pub mod arrangement;
 pub mod cache;
 pub mod overdraw;
 

@@ -7,13 +7,19 @@
 
 pub mod params;
 
+mod centroid_grid;
+mod grid_walk;
+mod hilbert;
 mod hoppe;
 mod input;
 mod kcache;
 mod meshopt_fifo;
 mod meshopt_overdraw;
 mod meshopt_vcache;
+mod mla;
 mod random;
+mod recursive_cut;
+mod snake;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -53,6 +59,10 @@ pub struct Method {
 pub static METHODS: &[&Method] = &[
     &input::METHOD,
     &random::METHOD,
+    &snake::METHOD,
+    &hilbert::METHOD,
+    &recursive_cut::METHOD,
+    &mla::METHOD,
     &hoppe::METHOD,
     &kcache::METHOD,
     &meshopt_vcache::METHOD,
