@@ -1,5 +1,6 @@
-//! Speed of our metrics against meshoptimizer's analyzers, timed in the same run on the same
-//! index buffers, reported as ratios (meshopt time ÷ ours: above 1 means we are faster).
+//! Speed of our metrics against meshoptimizer's analyzers, and of our orderings against the
+//! meshoptimizer orderings they are peers of, timed in the same run on the same mesh, reported as
+//! ratios (meshopt time ÷ ours: above 1 means we are faster).
 //!
 //! What is compared, and how the definitions differ:
 //! - FIFO-16 and batch 32/32/32: identical models (tests/cache_vs_meshopt.rs proves equal counts).
@@ -7,13 +8,23 @@
 //!   and back faces into separate depth buffers, ties passing. Ours culls back faces and tests
 //!   LESS with the top-left rule, per view set. The closest equal workload is our `axis6` at 256²;
 //!   the counts differ by definition, the work is comparable.
+//! - Orderings ([`compare_orderings`]): `tipsify:cache=16` against `optimizeVertexCacheFifo(16)`
+//!   (the same algorithm) and `forsyth` (LRU 32) against `optimizeVertexCache` (a Forsyth-style
+//!   greedy with meshoptimizer's own score table and LRU 16), each with the ACMR of its order at
+//!   FIFO-16. meshoptimizer builds its vertex→triangle adjacency inside the call; our orderings get
+//!   it from the mesh's [`Topology`], built once per mesh for every method. The first row of each
+//!   pair times the ordering as triorder runs it; the `+ adjacency` row adds building that
+//!   adjacency, the like-for-like comparison.
 
+use std::hint::black_box;
 use std::time::Instant;
 
 use crate::mesh::Mesh;
 use crate::metrics::cache::{CacheModel, simulate};
+use crate::order::{self, OrderInput, forsyth::forsyth, tipsify::tipsify};
 use crate::peer;
 use crate::raster::{Framing, RasterBackend, ViewSet, cpu::CpuRaster};
+use crate::topology::{Topology, vertex_triangles};
 
 /// One timed comparison.
 #[derive(Debug, Clone)]
@@ -24,6 +35,8 @@ pub struct BenchRow {
     pub ours_seconds: f64,
     /// `None` where meshopt has no equivalent.
     pub meshopt_seconds: Option<f64>,
+    /// For orderings: the ACMR at FIFO-16 of our order and of meshopt's.
+    pub acmr: Option<(f64, f64)>,
 }
 
 impl BenchRow {
@@ -46,6 +59,26 @@ pub fn median_seconds(reps: usize, mut f: impl FnMut()) -> f64 {
     times[times.len() / 2]
 }
 
+/// Median wall time of each of `fs` over `reps` rounds. The functions take turns within a round,
+/// so that a change in machine load (other processes, clock boost) hits all of them alike; each
+/// timed call follows an untimed call of the same function, so each is timed with its own data in
+/// cache, as in a loop of calls, rather than with whatever the previous function left there.
+pub fn median_interleaved<const N: usize>(reps: usize, mut fs: [&mut dyn FnMut(); N]) -> [f64; N] {
+    let mut times = [(); N].map(|_| Vec::with_capacity(reps.max(1)));
+    for _ in 0..reps.max(1) {
+        for (f, t) in fs.iter_mut().zip(&mut times) {
+            f();
+            let start = Instant::now();
+            f();
+            t.push(start.elapsed().as_secs_f64());
+        }
+    }
+    times.map(|mut t| {
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    })
+}
+
 /// Times every comparison on `mesh`, drawn in meshoptimizer's vertex-cache order (the realistic
 /// case: an optimised mesh being analysed).
 pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
@@ -58,6 +91,7 @@ pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
         task: task.to_string(),
         ours_seconds: ours,
         meshopt_seconds: theirs,
+        acmr: None,
     };
     let mut rows = Vec::new();
     for (model, (c, w, p)) in
@@ -102,4 +136,54 @@ pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
     let ico = median_seconds(reps.min(5), overdraw(ViewSet::Ico(162), 512));
     rows.push(row("overdraw ico:162@512", ico, None));
     rows
+}
+
+/// Times our cache orderings against their meshoptimizer peers on `mesh` (input order as loaded)
+/// and measures each order's ACMR at FIFO-16. See the module notes for what each row includes.
+pub fn compare_orderings(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
+    let topology = Topology::new(mesh);
+    let input = OrderInput { mesh, topology: &topology };
+    let indices = peer::index_buffer(mesh);
+    let n = mesh.vertex_count();
+    let fifo16 = |triangles: &[[u32; 3]]| simulate(CacheModel::Fifo(16), triangles, n).acmr();
+    let ours_acmr = |spec: &str| {
+        let resolved = order::resolve(spec, 0).expect("a registered method");
+        order::run(&resolved, &input).map(|o| fifo16(&mesh.triangles_in_order(&o))).unwrap_or(f64::NAN)
+    };
+    let theirs_acmr =
+        |indices: Vec<u32>| fifo16(&indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<_>>());
+    let row = |task: &str, ours: f64, theirs: f64, acmr: (f64, f64)| BenchRow {
+        mesh: mesh.name.clone(),
+        triangles: mesh.triangle_count(),
+        task: task.to_string(),
+        ours_seconds: ours,
+        meshopt_seconds: Some(theirs),
+        acmr: Some(acmr),
+    };
+    let triangles = &mesh.triangles;
+
+    let fifo_acmr = (ours_acmr("tipsify:cache=16"), theirs_acmr(meshopt::optimize_vertex_cache_fifo(&indices, n, 16)));
+    let [fifo_theirs, ours, with_adjacency] = median_interleaved(
+        reps,
+        [
+            &mut || drop(black_box(meshopt::optimize_vertex_cache_fifo(black_box(&indices), n, 16))),
+            &mut || drop(black_box(tipsify(black_box(triangles), &topology.vertex_triangles, 16))),
+            &mut || drop(black_box(tipsify(black_box(triangles), &vertex_triangles(mesh), 16))),
+        ],
+    );
+    let vcache_acmr = (ours_acmr("forsyth:cache=32"), theirs_acmr(meshopt::optimize_vertex_cache(&indices, n)));
+    let [vcache_theirs, forsyth_ours, forsyth_with_adjacency] = median_interleaved(
+        reps,
+        [
+            &mut || drop(black_box(meshopt::optimize_vertex_cache(black_box(&indices), n))),
+            &mut || drop(black_box(forsyth(black_box(triangles), &topology.vertex_triangles, 32))),
+            &mut || drop(black_box(forsyth(black_box(triangles), &vertex_triangles(mesh), 32))),
+        ],
+    );
+    vec![
+        row("tipsify:cache=16 vs optimizeVertexCacheFifo(16)", ours, fifo_theirs, fifo_acmr),
+        row("  the same, + adjacency", with_adjacency, fifo_theirs, fifo_acmr),
+        row("forsyth:cache=32 vs optimizeVertexCache", forsyth_ours, vcache_theirs, vcache_acmr),
+        row("  the same, + adjacency", forsyth_with_adjacency, vcache_theirs, vcache_acmr),
+    ]
 }

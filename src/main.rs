@@ -47,6 +47,13 @@ struct Measure {
     backend: String,
 }
 
+/// The two halves of `bench`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum BenchPart {
+    Metrics,
+    Orderings,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// List every ordering method with its parameters, defaults and source paper or library.
@@ -114,11 +121,18 @@ enum Command {
         #[command(flatten)]
         common: Common,
     },
-    /// Time our metrics against meshoptimizer (the meshopt crate) in the same run.
+    /// Time our metrics and orderings against meshoptimizer (the meshopt crate) in the same run.
     Bench {
         /// Repetitions per timing (the median is reported).
         #[arg(long, default_value_t = 11)]
         reps: usize,
+        /// Mesh(es) to time, repeatable (default: three large shared models, or a procedural
+        /// sphere and the bundled cow when there is no data directory).
+        #[arg(long = "mesh", value_name = "MESH")]
+        meshes: Vec<String>,
+        /// Time only the metrics or only the orderings.
+        #[arg(long, value_enum)]
+        only: Option<BenchPart>,
         #[command(flatten)]
         common: Common,
     },
@@ -137,7 +151,7 @@ fn main() -> ExitCode {
         Command::Run { spec, quick, common } => commands::run(&spec, quick, &common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick),
         Command::Reproduce { quick, only, common } => commands::reproduce(quick, only.as_deref(), &common),
-        Command::Bench { reps, common } => commands::bench(reps, &common),
+        Command::Bench { reps, meshes, only, common } => commands::bench(reps, &meshes, only, &common),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,7 +7,7 @@ use triorder::experiment::{self, RunOptions, provenance};
 use triorder::figure::{self, PlotOptions};
 use triorder::mesh::source;
 
-use crate::Common;
+use crate::{BenchPart, Common};
 
 fn run_options(quick: bool, common: &Common) -> RunOptions {
     RunOptions { quick, data: common.data.clone(), progress: true, ..Default::default() }
@@ -38,29 +38,60 @@ const BENCH_MODELS: [&str; 3] =
     ["models/bun_zipper.ply", "models/happy_buddha_100k.obj", "models/dragon_vrip_res2.ply"];
 const BENCH_FALLBACK: [&str; 2] = ["sphere:100000", "assets/spot.obj"];
 
-pub fn bench(reps: usize, common: &Common) -> Result<()> {
+pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &Common) -> Result<()> {
     let data = source::data_dir(common.data.as_deref());
-    let models: &[&str] = if data.is_some() { &BENCH_MODELS } else { &BENCH_FALLBACK };
+    let defaults: &[&str] = if data.is_some() { &BENCH_MODELS } else { &BENCH_FALLBACK };
+    let models: Vec<&str> =
+        if meshes.is_empty() { defaults.to_vec() } else { meshes.iter().map(String::as_str).collect() };
+    let meshes = models
+        .iter()
+        .map(|model| source::open(model, data.as_deref(), common.seed).map(|mesh| (*model, mesh)))
+        .collect::<Result<Vec<_>>>()?;
     println!("machine: {}", provenance::machine());
-    println!("median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster)\n");
-    println!(
-        "{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",
-        "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup"
-    );
-    for model in models {
-        let mesh = source::open(model, data.as_deref(), common.seed)?;
-        for r in triorder::bench::compare(&mesh, reps) {
-            let theirs = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.3}", s * 1e3));
-            let speedup = r.speedup().map_or("-".to_string(), |s| format!("{s:.2}x"));
-            println!(
-                "{:<28} {:>9}  {:<46} {:>10.3} {:>10} {:>8}",
-                model,
-                r.triangles,
-                r.task,
-                r.ours_seconds * 1e3,
-                theirs,
-                speedup
-            );
+    println!("median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster)");
+    if only != Some(BenchPart::Orderings) {
+        println!(
+            "\n{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",
+            "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup"
+        );
+        for (model, mesh) in &meshes {
+            for r in triorder::bench::compare(mesh, reps) {
+                let theirs = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.3}", s * 1e3));
+                let speedup = r.speedup().map_or("-".to_string(), |s| format!("{s:.2}x"));
+                println!(
+                    "{:<28} {:>9}  {:<46} {:>10.3} {:>10} {:>8}",
+                    model,
+                    r.triangles,
+                    r.task,
+                    r.ours_seconds * 1e3,
+                    theirs,
+                    speedup
+                );
+            }
+        }
+    }
+    if only != Some(BenchPart::Metrics) {
+        println!("\norderings on the input order as loaded; ACMR at fifo:16 (ratio = ours / meshopt)");
+        println!(
+            "{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8} {:>8} {:>8} {:>7}",
+            "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup", "ACMR", "meshopt", "ratio"
+        );
+        for (model, mesh) in &meshes {
+            for r in triorder::bench::compare_orderings(mesh, reps) {
+                let (ours, theirs) = r.acmr.unwrap_or((f64::NAN, f64::NAN));
+                println!(
+                    "{:<28} {:>9}  {:<46} {:>10.3} {:>10.3} {:>7.2}x {:>8.4} {:>8.4} {:>7.4}",
+                    model,
+                    r.triangles,
+                    r.task,
+                    r.ours_seconds * 1e3,
+                    r.meshopt_seconds.unwrap_or(f64::NAN) * 1e3,
+                    r.speedup().unwrap_or(f64::NAN),
+                    ours,
+                    theirs,
+                    ours / theirs
+                );
+            }
         }
     }
     Ok(())

@@ -8,6 +8,7 @@
 pub mod params;
 
 mod centroid_grid;
+pub(crate) mod forsyth;
 mod grid_walk;
 mod hilbert;
 mod hoppe;
@@ -20,6 +21,8 @@ mod mla;
 mod random;
 mod recursive_cut;
 mod snake;
+mod strips;
+pub(crate) mod tipsify;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -63,7 +66,10 @@ pub static METHODS: &[&Method] = &[
     &hilbert::METHOD,
     &recursive_cut::METHOD,
     &mla::METHOD,
+    &strips::METHOD,
     &hoppe::METHOD,
+    &tipsify::METHOD,
+    &forsyth::METHOD,
     &kcache::METHOD,
     &meshopt_vcache::METHOD,
     &meshopt_fifo::METHOD,

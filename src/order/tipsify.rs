@@ -1,0 +1,223 @@
+//! `tipsify`: Sander, Nehab & Barczak 2007, "Fast triangle reordering for vertex locality and
+//! reduced overdraw", §3 (Tipsify), our own implementation (ALGORITHMS.md §2).
+//!
+//! Tipsify emits triangles as fans around one vertex at a time. After a fan it moves to the
+//! neighbouring vertex that will still be in a FIFO of `cache` entries once its own fan has been
+//! drawn — the oldest such vertex, so the cache is used before it is lost — and when no neighbour
+//! has triangles left it backs up along a dead-end stack of recently used vertices, then scans the
+//! vertex ids. It needs only vertex→triangle adjacency, so it works on non-manifold meshes, and it
+//! does O(1) work per triangle corner whatever the cache size.
+//!
+//! The paper's pitfalls, as we resolve them: the fan test is `s − C[v] + 2·L[v] ≤ k` (the
+//! pseudo-code's `≤`, not the text's `>`); the best priority starts at −1 so that any live
+//! candidate beats a dead end; priorities use the timestamp `s` after the fan has been emitted;
+//! the start vertex is 0 and the cursor runs over vertex ids in order, so the result depends on
+//! vertex numbering, as in the paper.
+
+use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use crate::error::Result;
+use crate::topology::Csr;
+
+pub static METHOD: Method = Method {
+    name: "tipsify",
+    summary: "Tipsify: vertex fans steered by a FIFO cache model, O(F)",
+    source: "Sander, Nehab & Barczak 2007, §3 (Tipsify)",
+    peer: false,
+    params: &[ParamInfo {
+        name: "cache",
+        default: "16",
+        kind: ParamKind::Int { min: 3, max: 1 << 16 },
+        help: "FIFO size the order is tuned for",
+    }],
+    build,
+};
+
+fn build(params: &Params) -> Box<dyn Ordering> {
+    Box::new(Tipsify { cache: params.int("cache") as u32 })
+}
+
+struct Tipsify {
+    cache: u32,
+}
+
+impl Ordering for Tipsify {
+    fn order(&self, input: &OrderInput) -> Result<Order> {
+        Ok(tipsify(&input.mesh.triangles, &input.topology.vertex_triangles, self.cache).0)
+    }
+}
+
+/// Marks "no vertex" in the fan-vertex search.
+const NONE: u32 = u32::MAX;
+
+/// Tipsify with a FIFO of `cache` entries over `triangles`, whose vertex→triangle adjacency is
+/// `vertex_triangles` (as [`crate::topology::vertex_triangles`] builds it). Returns the order and
+/// the positions in it where a dead end forced a jump (the first triangle of each run that did
+/// not continue from the previous fan's neighbourhood; position 0 included). Those are the hard
+/// cluster boundaries of the paper's fast linear clustering (§4), which `sander07` will cut at.
+pub(crate) fn tipsify(triangles: &[[u32; 3]], vertex_triangles: &Csr, cache: u32) -> (Order, Vec<usize>) {
+    let offsets = vertex_triangles.offsets();
+    let adjacent = vertex_triangles.items();
+    let mut fans = Fans {
+        triangles,
+        vertices: offsets.windows(2).map(|w| Vertex { live: w[1] - w[0], stamp: 0 }).collect(),
+        emitted: vec![false; triangles.len()],
+        dead_end: vec![0; 3 * triangles.len()],
+        top: 0,
+        order: vec![0; triangles.len()],
+        count: 0,
+        now: cache + 1,
+        cache,
+    };
+    let mut dead_ends = Vec::new();
+    let mut cursor = 0usize;
+    // Start of the current fan's corners on the stack: the candidates for the next fan vertex.
+    let mut candidates_from = 0;
+    loop {
+        let mut fan = next_neighbour(&fans.dead_end[candidates_from..fans.top], &fans.vertices, fans.now, cache);
+        if fan == NONE {
+            fan = next_after_dead_end(&fans.dead_end, &mut fans.top, &mut cursor, &fans.vertices);
+            if fan == NONE {
+                break;
+            }
+            dead_ends.push(fans.count);
+        }
+        candidates_from = fans.top;
+        fans.emit(fan, &adjacent[offsets[fan as usize] as usize..offsets[fan as usize + 1] as usize]);
+    }
+    (fans.order, dead_ends)
+}
+
+/// Tipsify's state. Every emitted corner is pushed on `dead_end[..top]`; the part pushed by the
+/// current fan doubles as the candidate set for the next fan vertex, so no separate set is kept.
+/// The buffers are sized once (a triangle pushes three corners), so they are written by index,
+/// with no allocation or growth check per step.
+struct Fans<'a> {
+    triangles: &'a [[u32; 3]],
+    vertices: Vec<Vertex>,
+    emitted: Vec<bool>,
+    dead_end: Vec<u32>,
+    top: usize,
+    order: Order,
+    /// Triangles emitted so far: `order[..count]`.
+    count: usize,
+    /// The FIFO's timestamp `s`.
+    now: u32,
+    cache: u32,
+}
+
+impl Fans<'_> {
+    /// Emits the live triangles of `row`, the adjacency row of vertex `fan`, in order (keeping
+    /// each one's corners as given), updating live counts and the FIFO. Out of line, with its
+    /// counters in locals, so that its loop keeps them in registers.
+    #[inline(never)]
+    fn emit(&mut self, fan: u32, row: &[u32]) {
+        let Fans { triangles, vertices, emitted, dead_end, order, cache, .. } = self;
+        let (mut top, mut count, mut now) = (self.top, self.count, self.now);
+        for &t in row {
+            // The fan's live count says how many of its triangles are left: stop once all are
+            // out rather than testing the rest of the row.
+            if vertices[fan as usize].live == 0 {
+                break;
+            }
+            let flag = &mut emitted[t as usize];
+            if *flag {
+                continue;
+            }
+            *flag = true;
+            order[count] = t;
+            count += 1;
+            let tri = triangles[t as usize];
+            dead_end[top..top + 3].copy_from_slice(&tri);
+            top += 3;
+            for v in tri {
+                let vertex = &mut vertices[v as usize];
+                vertex.live -= 1;
+                if now - vertex.stamp > *cache {
+                    vertex.stamp = now;
+                    now += 1;
+                }
+            }
+        }
+        (self.top, self.count, self.now) = (top, count, now);
+    }
+}
+
+/// What Tipsify tracks per vertex, side by side so one memory access serves both: `live` =
+/// triangles not yet emitted (a triangle with a repeated corner counts per corner, as the CSR
+/// lists it per corner, so the two agree), and `stamp` = its FIFO timestamp (ALGORITHMS.md
+/// preamble: v is cached iff `now - stamp <= cache`).
+#[derive(Clone, Copy)]
+struct Vertex {
+    live: u32,
+    stamp: u32,
+}
+
+/// The candidate that is still cached after its fan is drawn, preferring the oldest (largest
+/// `now - stamp`); a live candidate that would fall out scores 0; dead ones are skipped. Ties go
+/// to the first candidate, i.e. the earliest emitted corner.
+fn next_neighbour(candidates: &[u32], vertices: &[Vertex], now: u32, cache: u32) -> u32 {
+    let mut best = NONE;
+    let mut best_priority = -1i64;
+    for &v in candidates {
+        let Vertex { live, stamp } = vertices[v as usize];
+        if live == 0 {
+            continue;
+        }
+        let age = now - stamp;
+        // u64: 2·L can exceed u32 on a huge fan; it cannot exceed u64.
+        let priority = if u64::from(age) + 2 * u64::from(live) <= u64::from(cache) { i64::from(age) } else { 0 };
+        if priority > best_priority {
+            best = v;
+            best_priority = priority;
+        }
+    }
+    best
+}
+
+/// Dead end: the most recently used vertex that still has live triangles (popping the stack,
+/// `dead_end[..top]`, as we go), else the next vertex id with live triangles, else [`NONE`]
+/// (all emitted).
+fn next_after_dead_end(dead_end: &[u32], top: &mut usize, cursor: &mut usize, vertices: &[Vertex]) -> u32 {
+    while *top > 0 {
+        *top -= 1;
+        let v = dead_end[*top];
+        if vertices[v as usize].live > 0 {
+            return v;
+        }
+    }
+    while *cursor < vertices.len() {
+        if vertices[*cursor].live > 0 {
+            return *cursor as u32;
+        }
+        *cursor += 1;
+    }
+    NONE
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Mesh, procedural};
+    use crate::topology::vertex_triangles;
+
+    #[test]
+    fn dead_ends_mark_the_jumps() {
+        // Two disjoint triangles: vertex 0's fan is the first, nothing neighbours it, so the
+        // second starts after a dead end at position 1.
+        let positions = vec![glam::Vec3::ZERO; 6];
+        let mesh = Mesh::new("two", positions, vec![[3, 4, 5], [0, 1, 2]], Default::default()).unwrap();
+        let (order, dead_ends) = tipsify(&mesh.triangles, &vertex_triangles(&mesh), 16);
+        assert_eq!(order, vec![1, 0]);
+        assert_eq!(dead_ends, vec![0, 1]);
+    }
+
+    #[test]
+    fn a_grid_has_few_dead_ends() {
+        let mesh = procedural::generate("grid:32x32", 0).unwrap().unwrap();
+        let (order, dead_ends) = tipsify(&mesh.triangles, &vertex_triangles(&mesh), 16);
+        assert_eq!(order.len(), mesh.triangle_count());
+        assert_eq!(dead_ends[0], 0);
+        assert!(dead_ends.windows(2).all(|w| w[0] < w[1]));
+        assert!(dead_ends.len() < mesh.triangle_count() / 16, "{} dead ends", dead_ends.len());
+    }
+}
