@@ -123,7 +123,7 @@ where
 /// lasts.
 pub struct Colors(Vec<(String, RGBColor)>);
 
-const PALETTE: [RGBColor; 10] = [
+const PALETTE: [RGBColor; 16] = [
     RGBColor(0x4d, 0x4d, 0x4d), // grey
     RGBColor(0xe1, 0x57, 0x59), // red
     RGBColor(0x4e, 0x79, 0xa7), // blue
@@ -134,6 +134,12 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(0x9c, 0x75, 0x5f), // brown
     RGBColor(0xed, 0xc9, 0x48), // yellow
     RGBColor(0xff, 0x9d, 0xa7), // pink
+    RGBColor(0x17, 0xbe, 0xcf), // cyan
+    RGBColor(0x11, 0x11, 0x11), // black
+    RGBColor(0x7f, 0x3c, 0x8d), // dark purple
+    RGBColor(0x1b, 0x6e, 0x3b), // dark green
+    RGBColor(0x1f, 0x3a, 0x93), // navy
+    RGBColor(0xe3, 0x77, 0xc2), // magenta
 ];
 
 impl Colors {

@@ -40,7 +40,7 @@ const MARGIN: u32 = 10;
 const TITLE_H: u32 = 44;
 const LEGEND_H: u32 = 40;
 /// Corner images are rendered at this many pixels per SVG pixel, so zooming in stays sharp.
-const OVERSAMPLE: f32 = 2.0;
+const OVERSAMPLE: f32 = 1.5;
 
 /// Corner colours: hit, first load, first reload, later reloads.
 const HIT: [u8; 3] = [200, 200, 200];
@@ -380,7 +380,7 @@ fn legend(root: &super::axes::Area, kind: &Content, y: i32) -> DrawResult {
                 let [r, g, b] = color;
                 root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], RGBColor(r, g, b).filled()))?;
                 root.draw_text(label, &style, (x + 20, y))?;
-                x += 44 + axes::text_width(label, 13.0) / 2;
+                x += 44 + axes::text_width(label, 13.0);
             }
             Ok(())
         }

@@ -14,7 +14,7 @@ use super::{Extent, Kind, XAxis};
 const ROW_H: i32 = 24;
 const HEAD_H: i32 = 64;
 const FIRST_COL_W: i32 = 230;
-const COL_W: i32 = 96;
+const COL_W: i32 = 104;
 
 /// The same values as a bar chart holds (panel × series × category), drawn as text.
 pub struct Tables(pub Bars);
@@ -55,8 +55,10 @@ impl Kind for Tables {
                 [(x - COL_W + 10, y + HEAD_H - 30), (x, y + HEAD_H - 27)],
                 colors.of(name).filled(),
             ))?;
-            for (k, line) in axes::wrap(name, 13).iter().take(2).enumerate() {
-                area.draw_text(line, &head, (x, y + 4 + 14 * k as i32))?;
+            // A method spec on two lines: the name, then its parameters.
+            let (first, rest) = name.split_once(':').unwrap_or((name, ""));
+            for (k, line) in [first, rest].iter().enumerate() {
+                area.draw_text(&truncate(line, 14), &head, (x, y + 4 + 14 * k as i32))?;
             }
         }
         y += HEAD_H - 20;
