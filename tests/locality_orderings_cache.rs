@@ -10,23 +10,6 @@ use triorder::metrics::cache::{CacheModel, simulate};
 use triorder::order::{self, OrderInput};
 use triorder::topology::Topology;
 
-/// Every model in the shared data directory.
-const SHARED: [&str; 13] = [
-    "bun_zipper.ply",
-    "bunny_2k.ply",
-    "dragon_vrip_res2.ply",
-    "dragon_vrip_res3.ply",
-    "dragon_vrip_res4.ply",
-    "happy_buddha_100k.obj",
-    "horse.ply",
-    "feline.obj",
-    "armadillo.obj",
-    "spot.obj",
-    "nefertiti_lowres.obj",
-    "pirate.obj",
-    "rocker-arm.obj",
-];
-
 fn order_of(spec: &str, mesh: &Mesh, topology: &Topology) -> Vec<u32> {
     let resolved = order::resolve(spec, 0).unwrap();
     order::run(&resolved, &OrderInput { mesh, topology }).unwrap()
@@ -108,7 +91,7 @@ fn tipsify_matches_meshopt_fifo() {
     let theirs = acmr_of("meshopt-fifo:cache=16", CacheModel::Fifo(16), &bunny, &topology);
     assert!(ours <= 1.02 * theirs, "bun_zipper fifo:16: tipsify {ours:.4}, meshopt-fifo {theirs:.4}");
 
-    for name in SHARED {
+    for name in common::STATIC_MODELS {
         let Some(mesh) = common::real_mesh(name) else { return };
         let topology = Topology::new(&mesh);
         for k in [10, 16, 32] {
@@ -123,7 +106,7 @@ fn tipsify_matches_meshopt_fifo() {
 /// shared mesh; nor does the default (k = 16) order measured at any of those sizes.
 #[test]
 fn tipsify_never_loses_to_random() {
-    for name in SHARED {
+    for name in common::STATIC_MODELS {
         let Some(mesh) = common::real_mesh(name) else { return };
         let topology = Topology::new(&mesh);
         let random = order_of("random:seed=1", &mesh, &topology);

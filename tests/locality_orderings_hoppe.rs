@@ -9,24 +9,6 @@ use triorder::metrics::cache::{CacheModel, simulate};
 use triorder::order::{self, OrderInput};
 use triorder::topology::Topology;
 
-/// Every shared model (dragon_vrip_res2, 202k triangles, included: both orderings take well under
-/// a second on it in release).
-const MODELS: &[&str] = &[
-    "bun_zipper.ply",
-    "bunny_2k.ply",
-    "dragon_vrip_res2.ply",
-    "dragon_vrip_res3.ply",
-    "dragon_vrip_res4.ply",
-    "happy_buddha_100k.obj",
-    "horse.ply",
-    "feline.obj",
-    "armadillo.obj",
-    "spot.obj",
-    "nefertiti_lowres.obj",
-    "pirate.obj",
-    "rocker-arm.obj",
-];
-
 fn ordered(mesh: &Mesh, topology: &Topology, spec: &str) -> Vec<[u32; 3]> {
     let resolved = order::resolve(spec, 0).unwrap();
     let order = order::run(&resolved, &OrderInput { mesh, topology }).unwrap_or_else(|e| panic!("{spec}: {e}"));
@@ -40,7 +22,7 @@ fn misses(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize) -> u64
 #[test]
 fn never_worse_than_random_at_any_fifo_size() {
     let mut checked = 0;
-    for name in MODELS {
+    for name in common::STATIC_MODELS {
         let Some(mesh) = common::real_mesh(name) else { return };
         let topology = Topology::new(&mesh);
         let n = mesh.vertex_count();

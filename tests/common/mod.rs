@@ -6,6 +6,23 @@ use std::path::PathBuf;
 
 use triorder::mesh::{Mesh, load};
 
+/// Every static model in the shared data directory (`models/`), as MANIFEST.md lists them.
+pub const STATIC_MODELS: [&str; 13] = [
+    "bun_zipper.ply",
+    "bunny_2k.ply",
+    "dragon_vrip_res2.ply",
+    "dragon_vrip_res3.ply",
+    "dragon_vrip_res4.ply",
+    "happy_buddha_100k.obj",
+    "horse.ply",
+    "feline.obj",
+    "armadillo.obj",
+    "spot.obj",
+    "nefertiti_lowres.obj",
+    "pirate.obj",
+    "rocker-arm.obj",
+];
+
 /// The shared data directory (`$TRIORDER_DATA`, else ../shared/data beside the crate), if present.
 pub fn data_dir() -> Option<PathBuf> {
     let dir = std::env::var_os("TRIORDER_DATA")
