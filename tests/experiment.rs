@@ -83,7 +83,7 @@ fn repository_specs_parse() {
     }
     let acmr = Spec::load(&dir.join("universal-acmr-vs-cache.toml")).unwrap();
     assert_eq!(acmr.methods.len(), order::METHODS.len());
-    assert_eq!(acmr.full.caches.len(), 31);
+    assert_eq!(acmr.full.caches.len(), 17);
     assert_eq!(acmr.full.caches[0], CacheModel::Fifo(4));
     assert_eq!(acmr.quick.as_ref().unwrap().caches.len(), 16);
     let ovr = Spec::load(&dir.join("ovr-distribution-bunny.toml")).unwrap();
@@ -361,9 +361,11 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     run(&path, &quick(root.path())).unwrap();
     let orders = root.path().join("results/quick/corners.orders.csv");
     let (header, rows) = read_csv(&orders);
-    assert_eq!(header, ["model", "method", "position", "triangle"]);
-    // Every (model, method) pair saved as a whole order: 80 + 32 triangles, three methods.
-    assert_eq!(rows.len(), 3 * (80 + 32));
+    assert_eq!(header, ["model", "method", "order"]);
+    // One whole order per (model, method): 80 and 32 triangles, three methods.
+    assert_eq!(rows.len(), 2 * 3);
+    let lengths: Vec<usize> = rows.iter().map(|r| r["order"].split(' ').count()).collect();
+    assert_eq!(lengths, [80, 80, 80, 32, 32, 32]);
     let svg = std::fs::read_to_string(plot(&path, &plot_quick(root.path())).unwrap()).unwrap();
     // Two models × three methods × three caches, one picture each.
     assert_eq!(svg.matches("<image").count(), 18);
@@ -371,11 +373,11 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     // Swap two triangles of one saved order: its corner counts no longer match the CSV's ACMR.
     let text = std::fs::read_to_string(&orders).unwrap();
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let input_row = |i: usize| lines.iter().position(|l| l.starts_with(&format!("sphere:80,input,{i},"))).unwrap();
-    let (a, b) = (input_row(0), input_row(40));
-    let (ta, tb) = (lines[a].rsplit(',').next().unwrap().to_string(), lines[b].rsplit(',').next().unwrap().to_string());
-    lines[a] = format!("sphere:80,input,0,{tb}");
-    lines[b] = format!("sphere:80,input,40,{ta}");
+    let input = lines.iter().position(|l| l.starts_with("sphere:80,input,")).unwrap();
+    let (head, ids) = lines[input].rsplit_once(',').unwrap();
+    let mut ids: Vec<&str> = ids.split(' ').collect();
+    ids.swap(0, 40);
+    lines[input] = format!("{head},{}", ids.join(" "));
     std::fs::write(&orders, lines.join("\n") + "\n").unwrap();
     let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
     assert!(err.contains("corners.orders.csv") && err.contains("rerun the experiment"), "{err}");

@@ -174,14 +174,14 @@ impl Context {
     }
 }
 
-/// One line of a drawing spec's orders file: the `position`-th triangle drawn.
+/// One line of a drawing spec's orders file: a whole order, the triangle ids in draw order
+/// separated by spaces (one line per order keeps the file a seventh of one row per triangle).
 #[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct OrderRow {
     pub model: String,
     /// Canonical method spec, as in the results CSV.
     pub method: String,
-    pub position: usize,
-    pub triangle: u32,
+    pub order: String,
 }
 
 #[cfg(test)]

@@ -125,12 +125,8 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
             let evaluation = evaluate(&mesh, &topology, method, &measure, raster.as_ref())?;
             rows.extend(context.rows(model, &mesh, method.method.name, &evaluation));
             if save_orders {
-                orders.extend(evaluation.order.iter().enumerate().map(|(position, &triangle)| OrderRow {
-                    model: model.clone(),
-                    method: evaluation.method.clone(),
-                    position,
-                    triangle,
-                }));
+                let ids: Vec<String> = evaluation.order.iter().map(u32::to_string).collect();
+                orders.push(OrderRow { model: model.clone(), method: evaluation.method.clone(), order: ids.join(" ") });
             }
             bar.inc(1);
         }

@@ -148,15 +148,20 @@ fn read_orders(path: &Path) -> Result<HashMap<(String, String), Vec<u32>>> {
     })?;
     let mut orders: HashMap<(String, String), Vec<u32>> = HashMap::new();
     for (i, row) in reader.deserialize::<OrderRow>().enumerate() {
-        let row = row.map_err(|e| Error::input(path.display(), format!("line {}: {e}", i + 2)))?;
-        let order = orders.entry((row.model, row.method)).or_default();
-        if row.position != order.len() {
+        let line = i + 2;
+        let row = row.map_err(|e| Error::input(path.display(), format!("line {line}: {e}")))?;
+        let order = row
+            .order
+            .split_whitespace()
+            .map(|t| t.parse::<u32>())
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(|e| Error::input(path.display(), format!("line {line}: a triangle id that is not one: {e}")))?;
+        if orders.insert((row.model, row.method), order).is_some() {
             return Err(Error::input(
                 path.display(),
-                format!("line {}: position {} out of sequence", i + 2, row.position),
+                format!("line {line}: a second order for the same model and method"),
             ));
         }
-        order.push(row.triangle);
     }
     Ok(orders)
 }
