@@ -2,7 +2,7 @@
 //! Tipsify (Sander, Nehab & Barczak 2007, "Fast triangle reordering for vertex locality and
 //! reduced overdraw", §3), run through the `meshopt` crate for a given FIFO size.
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, OrderInput, Ordering, Params};
 use crate::error::Result;
 use crate::peer;
 
@@ -11,12 +11,7 @@ pub static METHOD: Method = Method {
     summary: "meshoptimizer optimizeVertexCacheFifo (Tipsify) [peer]",
     source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §3",
     peer: true,
-    params: &[ParamInfo {
-        name: "cache",
-        default: "16",
-        kind: ParamKind::Int { min: 3, max: 1 << 16 },
-        help: "FIFO size the order is tuned for",
-    }],
+    params: &[super::tipsify::FIFO_CACHE],
     build,
 };
 

@@ -23,13 +23,17 @@ pub static METHOD: Method = Method {
     summary: "Tipsify: vertex fans steered by a FIFO cache model, O(F)",
     source: "Sander, Nehab & Barczak 2007, §3 (Tipsify)",
     peer: false,
-    params: &[ParamInfo {
-        name: "cache",
-        default: "16",
-        kind: ParamKind::Int { min: 3, max: 1 << 16 },
-        help: "FIFO size the order is tuned for",
-    }],
+    params: &[FIFO_CACHE],
     build,
+};
+
+/// The FIFO size parameter, shared with the `meshopt-fifo` peer so the two always take the same
+/// values and compare like for like.
+pub(super) const FIFO_CACHE: ParamInfo = ParamInfo {
+    name: "cache",
+    default: "16",
+    kind: ParamKind::Int { min: 3, max: 1 << 16 },
+    help: "FIFO size the order is tuned for",
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {

@@ -56,9 +56,7 @@ impl RasterBackend for CpuRaster {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>> {
-        if !(1..=MAX_RESOLUTION).contains(&res) {
-            return Err(Error::usage(format!("resolution {res} is outside 1..={MAX_RESOLUTION}")));
-        }
+        check_resolution(res)?;
         cameras
             .par_iter()
             .enumerate()
@@ -77,14 +75,21 @@ impl RasterBackend for CpuRaster {
 /// index into `triangles` of the last fragment to pass the depth test there, under exactly the
 /// rules [`CpuRaster`] counts by. Figures use it to draw a mesh as the measurements see it.
 pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Camera, res: u32) -> Result<Vec<u32>> {
-    if !(1..=MAX_RESOLUTION).contains(&res) {
-        return Err(Error::usage(format!("resolution {res} is outside 1..={MAX_RESOLUTION}")));
-    }
+    check_resolution(res)?;
     let mut screen = Vec::new();
     project(positions, camera, res, &mut screen).map_err(Error::usage)?;
     let mut seen = vec![u32::MAX; res as usize * res as usize];
     draw(&screen, triangles, res, &mut Vec::new(), |pixel, t| seen[pixel] = t as u32);
     Ok(seen)
+}
+
+/// An image side the rasterizer can draw: 1 to [`MAX_RESOLUTION`] pixels.
+fn check_resolution(res: u32) -> Result<()> {
+    if (1..=MAX_RESOLUTION).contains(&res) {
+        Ok(())
+    } else {
+        Err(Error::usage(format!("resolution {res} is outside 1..={MAX_RESOLUTION}")))
+    }
 }
 
 /// Projects and snaps every vertex into `out`. Fails if a vertex lies outside the depth range
