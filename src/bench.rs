@@ -9,19 +9,23 @@
 //!   LESS with the top-left rule, per view set. The closest equal workload is our `axis6` at 256²;
 //!   the counts differ by definition, the work is comparable.
 //! - Orderings ([`compare_orderings`]): `tipsify:cache=16` against `optimizeVertexCacheFifo(16)`
-//!   (the same algorithm) and `forsyth` (LRU 32) against `optimizeVertexCache` (a Forsyth-style
-//!   greedy with meshoptimizer's own score table and LRU 16), each with the ACMR of its order at
-//!   FIFO-16. meshoptimizer builds its vertex→triangle adjacency inside the call; our orderings get
-//!   it from the mesh's [`Topology`], built once per mesh for every method. The first row of each
-//!   pair times the ordering as triorder runs it; the `+ adjacency` row adds building that
-//!   adjacency, the like-for-like comparison.
+//!   (the same algorithm) and `forsyth` (LRU 32, its default tuned score table) against
+//!   `optimizeVertexCache` (a Forsyth-style greedy with meshoptimizer's own tuned score table and
+//!   LRU 16), each with the ACMR of its order at FIFO-16. meshoptimizer builds its vertex→triangle
+//!   adjacency inside the call; our orderings get it from the mesh's [`Topology`], built once per
+//!   mesh for every method. The first row of each pair times the ordering as triorder runs it; the
+//!   `+ adjacency` row adds building that adjacency, the like-for-like comparison.
 
 use std::hint::black_box;
 use std::time::Instant;
 
 use crate::mesh::Mesh;
 use crate::metrics::cache::{CacheModel, simulate};
-use crate::order::{self, OrderInput, forsyth::forsyth, tipsify::tipsify};
+use crate::order::{
+    self, OrderInput,
+    forsyth::{Scores, forsyth},
+    tipsify::tipsify,
+};
 use crate::peer;
 use crate::raster::{Framing, RasterBackend, ViewSet, cpu::CpuRaster};
 use crate::topology::{Topology, vertex_triangles};
@@ -176,8 +180,8 @@ pub fn compare_orderings(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
         reps,
         [
             &mut || drop(black_box(meshopt::optimize_vertex_cache(black_box(&indices), n))),
-            &mut || drop(black_box(forsyth(black_box(triangles), &topology.vertex_triangles, 32))),
-            &mut || drop(black_box(forsyth(black_box(triangles), &vertex_triangles(mesh), 32))),
+            &mut || drop(black_box(forsyth(black_box(triangles), &topology.vertex_triangles, 32, Scores::Tuned))),
+            &mut || drop(black_box(forsyth(black_box(triangles), &vertex_triangles(mesh), 32, Scores::Tuned))),
         ],
     );
     vec![

@@ -70,7 +70,14 @@ fn cache_orderings_cope_with_awkward_input() {
         mesh(vec![[7, 8, 9]], 20),
         mesh(fan, 3002),
     ];
-    let specs = ["tipsify:cache=3", "tipsify:cache=65536", "forsyth:cache=4", "forsyth:cache=1024", "strips"];
+    let specs = [
+        "tipsify:cache=3",
+        "tipsify:cache=65536",
+        "forsyth:cache=4",
+        "forsyth:cache=1024",
+        "forsyth:scores=forsyth",
+        "strips",
+    ];
     for mesh in &meshes {
         let topology = Topology::new(mesh);
         for spec in specs {
@@ -122,21 +129,23 @@ fn tipsify_never_loses_to_random() {
     }
 }
 
-/// Forsyth's original score table against meshoptimizer's tuned one. The issue asks for 2% at
-/// FIFO-16 and LRU-32 on bunny_2k and bun_zipper. bunny_2k meets it (+0.2%, +1.6%); on
-/// bun_zipper Forsyth's constants give 2.7% and 2.4% more misses than meshoptimizer's table
-/// (measured; it is the table, not the search: every choice is checked to be the best-scoring
-/// one in the unit tests), so 3% is the bound that holds there.
+/// Issue 4 asks for ACMR within 2% of meshoptimizer's `optimizeVertexCache` at FIFO-16 and
+/// LRU-32. The default (tuned) score table meets it on every shared mesh, the eight larger ones
+/// held out of its tuning (src/order/forsyth.rs says how it was tuned). Forsyth's own table is
+/// held to the 3.5% it is measured within (3.3% worse on armadillo at FIFO-16): it must stay
+/// available and sane, and it is the reason the tuned table is the default.
 #[test]
 fn forsyth_is_close_to_meshopt_vcache() {
-    for (name, bound) in [("bunny_2k.ply", 1.02), ("bun_zipper.ply", 1.03)] {
+    for name in common::STATIC_MODELS {
         let Some(mesh) = common::real_mesh(name) else { return };
         let topology = Topology::new(&mesh);
-        let ours = order_of("forsyth", &mesh, &topology);
         let theirs = order_of("meshopt-vcache", &mesh, &topology);
-        for model in [CacheModel::Fifo(16), CacheModel::Lru(32)] {
-            let (ours, theirs) = (acmr(model, &mesh, &ours), acmr(model, &mesh, &theirs));
-            assert!(ours <= bound * theirs, "{name} {model}: forsyth {ours:.4}, meshopt-vcache {theirs:.4}");
+        for (spec, bound) in [("forsyth", 1.02), ("forsyth:scores=forsyth", 1.035)] {
+            let ours = order_of(spec, &mesh, &topology);
+            for model in [CacheModel::Fifo(16), CacheModel::Lru(32)] {
+                let (ours, theirs) = (acmr(model, &mesh, &ours), acmr(model, &mesh, &theirs));
+                assert!(ours <= bound * theirs, "{name} {model}: {spec} {ours:.4}, meshopt-vcache {theirs:.4}");
+            }
         }
     }
 }
