@@ -69,6 +69,9 @@ pub struct Evaluation {
     /// Wall time of the ordering alone.
     pub seconds: f64,
     pub order: Order,
+    /// Where the order's clusters start, ending with its length (`[0, n]` for methods without
+    /// clusters).
+    pub cluster_starts: Vec<usize>,
     pub measurement: Measurement,
 }
 
@@ -81,8 +84,15 @@ pub fn evaluate(
     raster: &dyn RasterBackend,
 ) -> Result<Evaluation> {
     let start = Instant::now();
-    let order = order::run(method, &OrderInput { mesh, topology })?;
+    let clustered = order::run_clustered(method, &OrderInput { mesh, topology })?;
     let seconds = start.elapsed().as_secs_f64();
-    let measurement = measure(mesh, &order, options, raster)?;
-    Ok(Evaluation { method: method.canonical(), peer: method.method.peer, seconds, order, measurement })
+    let measurement = measure(mesh, &clustered.order, options, raster)?;
+    Ok(Evaluation {
+        method: method.canonical(),
+        peer: method.method.peer,
+        seconds,
+        order: clustered.order,
+        cluster_starts: clustered.starts,
+        measurement,
+    })
 }

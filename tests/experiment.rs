@@ -135,6 +135,9 @@ modles = ["a"]"#,
         (r#"x = "cache_size""#, r#"x = "cache_sise""#, &["figure.x", "cache_sise"]),
         (r#"kind = "line""#, r#"kind = "pie""#, &["pie"]),
         (r#"metric = "acmr""#, r#"metric = "acmrr""#, &["figure.metric", "acmrr"]),
+        (r#"metric = "acmr""#, r#"metric = ["acmr", "atvr"]"#, &["several metrics", "\"metric\""]),
+        (r#"x = "cache_size""#, r#"x = "param:nope""#, &["figure.x", "no method of this spec has a parameter `nope`"]),
+        (r#"x = "cache_size""#, r#"x = "metric:atvr""#, &["figure.x", "metric:atvr"]),
         (r#"kind = "line""#, "kind = \"bar\"\nx_log = true", &["figure.x_log", "bar"]),
         (
             r#"models = ["sphere:80", "grid:4x4"]
@@ -248,6 +251,15 @@ fn every_figure_kind_draws_from_one_csv() {
         ("numbers", "kind = \"table\"\nmetric = \"acmr\"\nx = \"model\"\nfilter = { cache = \"fifo:8\" }", "grid:4x4"),
         ("paths", "kind = \"sequence\"\nmetric = \"acmr\"", "<polygon"),
         ("pictures", "kind = \"corners\"\nmetric = \"acmr\"\nview = [1, 1, 1]", "data:image/png;base64,"),
+        ("patches", "kind = \"clusters\"\nmetric = \"acmr\"", "colour: cluster"),
+        ("ranks", "kind = \"cluster-order\"\nmetric = \"acmr\"", "last cluster drawn"),
+        ("heat", "kind = \"overdraw\"\nmetric = \"acmr\"\nview = [0, 1, 0]", "5 or more"),
+        (
+            "metrics",
+            "kind = \"line\"\nmetric = [\"acmr\", \"atvr\"]\nx = \"param:seed\"\nseries = \"metric\"\nfacet = \"model\"\nfilter = { cache = \"fifo:8\" }",
+            "ATVR (misses per referenced vertex)",
+        ),
+        ("versus", "kind = \"scatter\"\nmetric = \"ovr_mean\"\nx = \"metric:ovr_max\"", "random:seed=2"),
     ];
     for (id, figure, want) in kinds {
         let text = TINY.replace("id = \"tiny\"", &format!("id = \"{id}\"")).replace(
@@ -361,11 +373,13 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     run(&path, &quick(root.path())).unwrap();
     let orders = root.path().join("results/quick/corners.orders.csv");
     let (header, rows) = read_csv(&orders);
-    assert_eq!(header, ["model", "method", "order"]);
-    // One whole order per (model, method): 80 and 32 triangles, three methods.
+    assert_eq!(header, ["model", "method", "order", "clusters"]);
+    // One whole order per (model, method): 80 and 32 triangles, three methods, none clustered.
     assert_eq!(rows.len(), 2 * 3);
     let lengths: Vec<usize> = rows.iter().map(|r| r["order"].split(' ').count()).collect();
     assert_eq!(lengths, [80, 80, 80, 32, 32, 32]);
+    let clusters: Vec<&str> = rows.iter().map(|r| r["clusters"].as_str()).collect();
+    assert_eq!(clusters, ["0 80", "0 80", "0 80", "0 32", "0 32", "0 32"]);
     let svg = std::fs::read_to_string(plot(&path, &plot_quick(root.path())).unwrap()).unwrap();
     // Two models × three methods × three caches, one picture each.
     assert_eq!(svg.matches("<image").count(), 18);
@@ -374,10 +388,10 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     let text = std::fs::read_to_string(&orders).unwrap();
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
     let input = lines.iter().position(|l| l.starts_with("sphere:80,input,")).unwrap();
-    let (head, ids) = lines[input].rsplit_once(',').unwrap();
-    let mut ids: Vec<&str> = ids.split(' ').collect();
+    let fields: Vec<&str> = lines[input].split(',').collect();
+    let mut ids: Vec<&str> = fields[2].split(' ').collect();
     ids.swap(0, 40);
-    lines[input] = format!("{head},{}", ids.join(" "));
+    lines[input] = format!("{},{},{},{}", fields[0], fields[1], ids.join(" "), fields[3]);
     std::fs::write(&orders, lines.join("\n") + "\n").unwrap();
     let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
     assert!(err.contains("corners.orders.csv") && err.contains("rerun the experiment"), "{err}");

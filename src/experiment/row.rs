@@ -182,6 +182,8 @@ pub struct OrderRow {
     /// Canonical method spec, as in the results CSV.
     pub method: String,
     pub order: String,
+    /// Where the order's clusters start, separated by spaces, ending with the triangle count.
+    pub clusters: String,
 }
 
 #[cfg(test)]

@@ -125,8 +125,13 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
             let evaluation = evaluate(&mesh, &topology, method, &measure, raster.as_ref())?;
             rows.extend(context.rows(model, &mesh, method.method.name, &evaluation));
             if save_orders {
-                let ids: Vec<String> = evaluation.order.iter().map(u32::to_string).collect();
-                orders.push(OrderRow { model: model.clone(), method: evaluation.method.clone(), order: ids.join(" ") });
+                let words = |values: &mut dyn Iterator<Item = String>| values.collect::<Vec<_>>().join(" ");
+                orders.push(OrderRow {
+                    model: model.clone(),
+                    method: evaluation.method.clone(),
+                    order: words(&mut evaluation.order.iter().map(u32::to_string)),
+                    clusters: words(&mut evaluation.cluster_starts.iter().map(usize::to_string)),
+                });
             }
             bar.inc(1);
         }

@@ -31,13 +31,18 @@
 //!
 //! [figure]
 //! kind = "line"                    # line | scatter | bar | distribution | table |
-//!                                  # sequence | corners (drawings of the meshes)
+//!                                  # sequence | corners | clusters | cluster-order | overdraw
+//!                                  # (drawings of the meshes)
 //! metric = "acmr"                  # the y values: rows whose `metric` column is this
 //!                                  # (acmr, atvr, seconds, ovr, ovr_mean, ovr_max, ovr_min,
-//!                                  # ovr_var, ovr_sum, ovr_empty)
+//!                                  # ovr_var, ovr_sum, ovr_empty), or a list of metrics drawn
+//!                                  # together (then series or facet = "metric")
 //! x = "cache_size"                 # CSV column on x (line, scatter: numeric; bar: categories;
 //!                                  # table: its rows;
-//!                                  # distribution: not allowed, it sorts the values itself)
+//!                                  # distribution: not allowed, it sorts the values itself).
+//!                                  # x, series, facet and filter keys may also name a method
+//!                                  # parameter, "param:clusters"; a scatter's x may name another
+//!                                  # metric of the same model and method, "metric:acmr"
 //! series = "method"                # optional (default method): one colour per value
 //! facet = "model"                  # optional: one small chart per value, all in one SVG
 //! filter = { cache_kind = "fifo" } # optional: keep only rows whose columns equal these values
@@ -115,7 +120,10 @@ pub struct Workload {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
     pub kind: FigureKind,
+    /// The first of [`Figure::metrics`]: the one that names the y axis.
     pub metric: String,
+    /// Every metric drawn; with more than one, `series` or `facet` is `metric`.
+    pub metrics: Vec<String>,
     pub x: Option<String>,
     pub series: String,
     pub facet: Option<String>,
@@ -152,12 +160,28 @@ pub enum FigureKind {
     /// Each (model, method, cache) drawn with every triangle corner coloured by whether its vertex
     /// hit, was loaded the first time, or reloaded (Bogomjakov & Gotsman 2002, Figs. 10 and 11).
     Corners,
+    /// Each (model, method) drawn with its clusters in distinct colours (Nehab et al. 2006, Fig. 3).
+    Clusters,
+    /// Each (model, method) drawn with its clusters shaded black (drawn first) to white (drawn
+    /// last) (Nehab et al. 2006, Fig. 6).
+    #[serde(rename = "cluster-order")]
+    ClusterOrder,
+    /// Each (model, method) drawn as a heat map of the fragments shaded at each pixel from the
+    /// figure's view: darker, more overdraw (Nehab et al. 2006, Fig. 1).
+    Overdraw,
 }
 
 impl FigureKind {
     /// Kinds that draw the meshes themselves and so need the orders saved by the run.
     pub fn draws_meshes(self) -> bool {
-        matches!(self, FigureKind::Sequence | FigureKind::Corners)
+        matches!(
+            self,
+            FigureKind::Sequence
+                | FigureKind::Corners
+                | FigureKind::Clusters
+                | FigureKind::ClusterOrder
+                | FigureKind::Overdraw
+        )
     }
 }
 
@@ -255,7 +279,7 @@ impl<'de> Deserialize<'de> for RawMethods {
 #[serde(deny_unknown_fields)]
 struct RawFigure {
     kind: FigureKind,
-    metric: String,
+    metric: OneOrMany,
     x: Option<String>,
     series: Option<String>,
     facet: Option<String>,
@@ -269,6 +293,14 @@ struct RawFigure {
     y_log: bool,
     y_range: Option<[f64; 2]>,
     view: Option<[f32; 3]>,
+}
+
+/// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum OneOrMany {
+    One(String),
+    Many(Vec<String>),
 }
 
 #[derive(Deserialize)]
@@ -318,7 +350,7 @@ impl RawSpec {
                 Some(work)
             }
         };
-        let figure = self.figure.check(&full).map_err(err)?;
+        let figure = self.figure.check(&full, &methods).map_err(err)?;
         Ok(Spec {
             path: path.to_path_buf(),
             id: self.id,
@@ -416,38 +448,66 @@ fn check_workload(
 }
 
 impl RawFigure {
-    fn check(self, full: &Workload) -> std::result::Result<Figure, String> {
-        let metric = METRICS.iter().find(|m| m.name == self.metric).ok_or_else(|| {
-            let known: Vec<_> = METRICS.iter().map(|m| m.name).collect();
-            format!("figure.metric `{}` is not a metric the CSV has (metrics: {})", self.metric, known.join(", "))
-        })?;
-        match metric.needs {
-            Needs::Caches if full.caches.is_empty() => {
-                return Err(format!("figure.metric = \"{}\" needs `caches`", metric.name));
+    fn check(self, full: &Workload, methods: &[String]) -> std::result::Result<Figure, String> {
+        let metrics = match self.metric {
+            OneOrMany::One(m) => vec![m],
+            OneOrMany::Many(ms) if ms.is_empty() => return Err("figure.metric is an empty list".into()),
+            OneOrMany::Many(ms) => ms,
+        };
+        for name in &metrics {
+            let metric = METRICS.iter().find(|m| m.name == name).ok_or_else(|| {
+                let known: Vec<_> = METRICS.iter().map(|m| m.name).collect();
+                format!("figure.metric `{name}` is not a metric the CSV has (metrics: {})", known.join(", "))
+            })?;
+            match metric.needs {
+                Needs::Caches if full.caches.is_empty() => {
+                    return Err(format!("figure.metric = \"{}\" needs `caches`", metric.name));
+                }
+                Needs::Views if full.views.is_none() => {
+                    return Err(format!("figure.metric = \"{}\" needs `views`", metric.name));
+                }
+                _ => {}
             }
-            Needs::Views if full.views.is_none() => {
-                return Err(format!("figure.metric = \"{}\" needs `views`", metric.name));
-            }
-            _ => {}
         }
-        let column = |key: &str, name: &str| {
+        let metric = metrics[0].clone();
+        if metrics.len() > 1 && self.series.as_deref() != Some("metric") && self.facet.as_deref() != Some("metric") {
+            return Err("figure.metric lists several metrics: set figure.series or figure.facet to \"metric\"".into());
+        }
+        // A CSV column; `param:NAME`, a parameter of the spec's methods; or, where `metric_ok`,
+        // `metric:NAME`, another metric joined on model and method.
+        let column = |key: &str, name: &str, metric_ok: bool| {
+            if let Some(param) = name.strip_prefix("param:") {
+                if methods.iter().any(|m| crate::figure::data::parameter(m, param).is_some()) {
+                    return Ok(());
+                }
+                return Err(format!("{key} `{name}`: no method of this spec has a parameter `{param}`"));
+            }
+            if let Some(other) = name.strip_prefix("metric:").filter(|_| metric_ok) {
+                if METRICS.iter().any(|m| m.name == other) {
+                    return Ok(());
+                }
+                return Err(format!("{key} `{name}`: `{other}` is not a metric"));
+            }
             if COLUMNS.contains(&name) {
                 Ok(())
             } else {
-                Err(format!("{key} `{name}` is not a CSV column (columns: {})", COLUMNS.join(", ")))
+                Err(format!(
+                    "{key} `{name}` is not a CSV column (columns: {}; or param:NAME{})",
+                    COLUMNS.join(", "),
+                    if metric_ok { ", metric:NAME" } else { "" }
+                ))
             }
         };
         let view = match (self.kind.draws_meshes(), self.view) {
-            (false, Some(_)) => return Err("figure.view is only for kind = \"sequence\" or \"corners\"".into()),
+            (false, Some(_)) => return Err("figure.view is only for the kinds that draw meshes".into()),
             (true, Some(v)) if !(v.iter().all(|c| c.is_finite()) && v.iter().any(|&c| c != 0.0)) => {
                 return Err(format!("figure.view = {v:?} must be a finite, non-zero direction"));
             }
             (_, v) => v.unwrap_or([0.0, 0.0, 1.0]),
         };
-        if self.kind.draws_meshes() && metric.name != "acmr" {
+        if self.kind.draws_meshes() && metrics != ["acmr"] {
             return Err(format!(
-                "figure.metric = \"{}\": kind = \"{}\" writes each drawing's ACMR, so metric must be \"acmr\"",
-                self.metric,
+                "figure.metric = {metrics:?}: kind = \"{}\" writes each drawing's ACMR, so metric must be \"acmr\"",
                 kind_name(self.kind)
             ));
         }
@@ -463,7 +523,7 @@ impl RawFigure {
             }
             (FigureKind::Distribution, None) => {}
             (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
-            (_, Some(x)) => column("figure.x", x)?,
+            (k, Some(x)) => column("figure.x", x, k == FigureKind::Scatter)?,
         }
         if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.draws_meshes()) {
             return Err(format!("figure.x_log / y_log: kind = \"{}\" has no axes", kind_name(self.kind)));
@@ -472,13 +532,13 @@ impl RawFigure {
             return Err(format!("figure.x_log: kind = \"{}\" has no numeric x axis", kind_name(self.kind)));
         }
         let series = self.series.unwrap_or_else(|| "method".into());
-        column("figure.series", &series)?;
+        column("figure.series", &series, false)?;
         if let Some(facet) = &self.facet {
-            column("figure.facet", facet)?;
+            column("figure.facet", facet, false)?;
         }
         let mut filter = Vec::new();
         for (key, value) in self.filter {
-            column("figure.filter key", &key)?;
+            column("figure.filter key", &key, false)?;
             let value = match value {
                 toml::Value::String(s) => s,
                 toml::Value::Integer(i) => i.to_string(),
@@ -498,7 +558,8 @@ impl RawFigure {
         };
         Ok(Figure {
             kind: self.kind,
-            metric: self.metric,
+            metric,
+            metrics,
             x: self.x,
             series,
             facet: self.facet,
@@ -521,6 +582,9 @@ fn kind_name(kind: FigureKind) -> &'static str {
         FigureKind::Distribution => "distribution",
         FigureKind::Table => "table",
         FigureKind::Sequence => "sequence",
+        FigureKind::Clusters => "clusters",
+        FigureKind::ClusterOrder => "cluster-order",
+        FigureKind::Overdraw => "overdraw",
         FigureKind::Corners => "corners",
     }
 }

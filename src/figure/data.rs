@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use csv::StringRecord;
 
 use crate::error::{Error, Result};
+use crate::experiment::row::METRICS;
 use crate::experiment::spec::{Figure, FigureKind};
 
 /// A results CSV in memory: its header and its records as text.
@@ -98,35 +99,74 @@ impl Table {
         seen
     }
 
+    /// Where a figure reads a column `name`: a CSV column; `param:NAME`, a parameter of the method
+    /// (read from its canonical spec); or, for x only, `metric:NAME`, the value of that metric for
+    /// the same model and method (so one metric can be plotted against another).
+    fn resolve(&self, name: &str) -> Result<Column> {
+        if let Some(param) = name.strip_prefix("param:") {
+            return Ok(Column::Param(self.column("method")?, param.to_string()));
+        }
+        let Some(metric) = name.strip_prefix("metric:") else {
+            return Ok(Column::Plain(self.column(name)?));
+        };
+        let (metric_col, value, model, method) =
+            (self.column("metric")?, self.column("value")?, self.column("model")?, self.column("method")?);
+        let mut values: Vec<((String, String), String)> = Vec::new();
+        for record in self.records.iter().filter(|r| &r[metric_col] == metric) {
+            let key = (record[model].to_string(), record[method].to_string());
+            match values.iter().find(|(k, _)| *k == key) {
+                Some((_, v)) if v != &record[value] => {
+                    return Err(Error::input(
+                        self.path.display(),
+                        format!(
+                            "has several `{metric}` values for model {} and method {}, so x = \"{name}\" is ambiguous",
+                            key.0, key.1
+                        ),
+                    ));
+                }
+                Some(_) => {}
+                None => values.push((key, record[value].to_string())),
+            }
+        }
+        Ok(Column::Metric { model, method, values })
+    }
+
     /// The panels `figure` draws. Errors name the CSV: no matching rows, a value that is not a
     /// number, or two rows at the same point of a line or bar chart (which would be ambiguous).
     pub fn select(&self, figure: &Figure) -> Result<Vec<Panel>> {
         let metric = self.column("metric")?;
         let value = self.column("value")?;
-        let series = self.column(&figure.series)?;
-        let facet = figure.facet.as_deref().map(|f| self.column(f)).transpose()?;
-        let x = figure.x.as_deref().map(|x| self.column(x)).transpose()?;
+        let series = self.resolve(&figure.series)?;
+        let facet = figure.facet.as_deref().map(|f| self.resolve(f)).transpose()?;
+        let x = figure.x.as_deref().map(|x| self.resolve(x)).transpose()?;
         let filter = figure
             .filter
             .iter()
-            .map(|(column, wanted)| Ok((self.column(column)?, wanted.as_str())))
+            .map(|(column, wanted)| Ok((self.resolve(column)?, wanted.as_str())))
             .collect::<Result<Vec<_>>>()?;
         let triangles =
             (figure.facet.as_deref() == Some("model")).then(|| self.column("model_triangles").ok()).flatten();
 
         let mut panels: Vec<Panel> = Vec::new();
         for (i, record) in self.records.iter().enumerate() {
-            if &record[metric] != figure.metric.as_str() || filter.iter().any(|&(c, wanted)| &record[c] != wanted) {
+            if !figure.metrics.iter().any(|m| m == &record[metric])
+                || filter.iter().any(|(c, wanted)| c.cell(record) != *wanted)
+            {
                 continue;
             }
             let line = i + 2;
             let y: f64 = record[value].parse().map_err(|_| {
                 Error::input(self.path.display(), format!("line {line}: value `{}` is not a number", &record[value]))
             })?;
-            let title = match (facet, triangles) {
+            let x = x.as_ref().map_or(String::new(), |c| c.cell(record));
+            if x.is_empty() && figure.x.as_deref().is_some_and(|c| c.starts_with("metric:") || c.starts_with("param:"))
+            {
+                continue; // a method without that parameter, or not measured by the x metric
+            }
+            let title = match (&facet, triangles) {
                 (None, _) => String::new(),
-                (Some(f), None) => record[f].to_string(),
-                (Some(f), Some(t)) => format!("{} ({} triangles)", &record[f], thousands(&record[t])),
+                (Some(f), None) => f.label(record),
+                (Some(f), Some(t)) => format!("{} ({} triangles)", f.label(record), thousands(&record[t])),
             };
             let panel = match panels.iter().position(|p| p.title == title) {
                 Some(p) => &mut panels[p],
@@ -135,15 +175,14 @@ impl Table {
                     panels.last_mut().expect("just pushed")
                 }
             };
-            let name = &record[series];
+            let name = series.label(record);
             let series = match panel.series.iter().position(|s| s.name == name) {
                 Some(s) => &mut panel.series[s],
                 None => {
-                    panel.series.push(Series { name: name.to_string(), points: Vec::new() });
+                    panel.series.push(Series { name: name.clone(), points: Vec::new() });
                     panel.series.last_mut().expect("just pushed")
                 }
             };
-            let x = x.map_or(String::new(), |c| record[c].to_string());
             if matches!(figure.kind, FigureKind::Line | FigureKind::Bar | FigureKind::Table)
                 && series.points.iter().any(|(px, _)| *px == x)
             {
@@ -151,7 +190,7 @@ impl Table {
                     self.path.display(),
                     format!(
                         "line {line}: a second `{}` row for series `{name}` at x = `{x}`{}; narrow the rows with figure.filter or split them with figure.series / figure.facet",
-                        figure.metric,
+                        &record[metric],
                         if panel.title.is_empty() { String::new() } else { format!(" in panel `{}`", panel.title) },
                     ),
                 ));
@@ -160,17 +199,61 @@ impl Table {
         }
         if panels.is_empty() {
             let mut metrics: Vec<&str> = self.records.iter().map(|r| &r[metric]).collect();
-            metrics.dedup();
             metrics.sort_unstable();
             metrics.dedup();
             let filter = if figure.filter.is_empty() { String::new() } else { " that pass figure.filter".to_string() };
             return Err(Error::input(
                 self.path.display(),
-                format!("has no `{}` rows{filter} (metrics present: {})", figure.metric, metrics.join(", ")),
+                format!(
+                    "has no `{}` rows{filter} (metrics present: {})",
+                    figure.metrics.join("`, `"),
+                    metrics.join(", ")
+                ),
             ));
         }
         Ok(panels)
     }
+}
+
+/// A column as [`Table::resolve`] finds it.
+enum Column {
+    Plain(usize),
+    /// The method column and the parameter's name.
+    Param(usize, String),
+    /// Another metric's value per (model, method): the model and method columns and the values.
+    Metric {
+        model: usize,
+        method: usize,
+        values: Vec<((String, String), String)>,
+    },
+}
+
+impl Column {
+    fn cell(&self, record: &StringRecord) -> String {
+        match self {
+            Column::Plain(i) => record[*i].to_string(),
+            Column::Param(method, name) => parameter(&record[*method], name).unwrap_or_default().to_string(),
+            Column::Metric { model, method, values } => values
+                .iter()
+                .find(|((m, s), _)| m == &record[*model] && s == &record[*method])
+                .map_or(String::new(), |(_, v)| v.clone()),
+        }
+    }
+
+    /// The cell as a legend or panel title shows it: metric names become their labels.
+    fn label(&self, record: &StringRecord) -> String {
+        let cell = self.cell(record);
+        match METRICS.iter().find(|m| m.name == cell) {
+            Some(m) if matches!(self, Column::Plain(_)) => m.label.to_string(),
+            _ => cell,
+        }
+    }
+}
+
+/// The value of parameter `name` in a canonical method spec `method:k=v,k=v`.
+pub fn parameter<'a>(spec: &'a str, name: &str) -> Option<&'a str> {
+    let (_, params) = spec.split_once(':')?;
+    params.split(',').find_map(|kv| kv.split_once('=').filter(|(k, _)| *k == name).map(|(_, v)| v))
 }
 
 /// `47794` → `47,794`.

@@ -62,7 +62,32 @@ enum Content {
     Sequence { adjacent: Vec<bool> },
     /// The class of each corner of each drawn triangle.
     Corners(Vec<[Corner; 3]>),
+    /// The colour of each drawn triangle's cluster, and which cluster it is in.
+    Clusters(Vec<([u8; 3], u32)>),
+    /// Fragments shaded per pixel from the figure's view.
+    Overdraw,
 }
+
+/// Per drawn triangle: its cluster's colour and index. Distinct colours are golden-ratio hues;
+/// in `by_rank` the first cluster drawn is black and the last white.
+fn cluster_colours(starts: &[usize], by_rank: bool) -> Vec<([u8; 3], u32)> {
+    let n = starts.len() - 1;
+    let mut colours = Vec::with_capacity(*starts.last().unwrap_or(&0));
+    for (c, w) in starts.windows(2).enumerate() {
+        let colour = if by_rank {
+            let g = (255.0 * c as f64 / (n.max(2) - 1) as f64).round() as u8;
+            [g, g, g]
+        } else {
+            let (r, g, b) = HSLColor((c as f64 * 0.618_034).fract(), 0.65, 0.55).rgb();
+            [r, g, b]
+        };
+        colours.extend(std::iter::repeat_n((colour, c as u32), w[1] - w[0]));
+    }
+    colours
+}
+
+/// Grey levels of the overdraw heat map: 1, 2, 3, 4 and 5 or more fragments shaded at a pixel.
+const OVERDRAW_GREYS: [u8; 5] = [235, 175, 120, 70, 20];
 
 /// Draws a drawing spec's figure (kind `sequence` or `corners`); returns the SVG's path.
 pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
@@ -78,7 +103,7 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
         let label = if work.models.len() > 1 { format!("{}: ", short(model)) } else { String::new() };
         let topology = (spec.figure.kind == FigureKind::Sequence).then(|| Topology::new(mesh));
         for method in &spec.methods {
-            let order = orders
+            let Saved { order, starts } = orders
                 .get(&(model.clone(), method.clone()))
                 .ok_or_else(|| stale(format!("has no order for `{method}` on `{model}`")))?;
             order::check_permutation(order, mesh.triangle_count())
@@ -88,11 +113,23 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
                 table.value("acmr", &[("model", model), ("method", method), ("cache", &cache.to_string())])
             };
             let name = method.split(':').next().unwrap_or(method);
-            match &topology {
-                Some(topology) => {
+            let checked_acmr = |cache: &CacheModel| -> Result<(f64, Vec<[Corner; 3]>)> {
+                let (stats, classes) = cache::corners(*cache, &triangles, mesh.vertex_count());
+                let recorded = acmr(cache)?;
+                if (stats.acmr() - recorded).abs() > 1e-9 * recorded.max(1.0) {
+                    return Err(stale(format!(
+                        "`{method}` on `{model}` gives ACMR {} at {cache}, the results say {recorded}",
+                        stats.acmr()
+                    )));
+                }
+                Ok((recorded, classes))
+            };
+            match spec.figure.kind {
+                FigureKind::Sequence => {
+                    let topology = topology.as_ref().expect("built for sequences");
                     let mut numbers = Vec::new();
                     for cache in &work.caches {
-                        numbers.push(format!("{} {}", cache, axes::number(acmr(cache)?)));
+                        numbers.push(format!("{} {}", cache, axes::number(checked_acmr(cache)?.0)));
                     }
                     let adjacent =
                         order.windows(2).map(|w| topology.neighbors.row(w[0] as usize).contains(&w[1])).collect();
@@ -103,16 +140,9 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
                         kind: Content::Sequence { adjacent },
                     });
                 }
-                None => {
+                FigureKind::Corners => {
                     for cache in &work.caches {
-                        let (stats, classes) = cache::corners(*cache, &triangles, mesh.vertex_count());
-                        let recorded = acmr(cache)?;
-                        if (stats.acmr() - recorded).abs() > 1e-9 * recorded.max(1.0) {
-                            return Err(stale(format!(
-                                "`{method}` on `{model}` gives ACMR {} at {cache}, the results say {recorded}",
-                                stats.acmr()
-                            )));
-                        }
+                        let (recorded, classes) = checked_acmr(cache)?;
                         drawings.push(Drawing {
                             mesh,
                             title: format!("{label}{name} · {cache} · ACMR {}", axes::number(recorded)),
@@ -120,6 +150,22 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
                             kind: Content::Corners(classes),
                         });
                     }
+                }
+                kind => {
+                    let cache = work.caches.first().ok_or_else(|| stale("has no cache model".into()))?;
+                    let (recorded, _) = checked_acmr(cache)?;
+                    let clusters = format!("{} clusters · ", starts.len() - 1);
+                    let (content, clusters) = match kind {
+                        FigureKind::Clusters => (Content::Clusters(cluster_colours(starts, false)), clusters),
+                        FigureKind::ClusterOrder => (Content::Clusters(cluster_colours(starts, true)), clusters),
+                        _ => (Content::Overdraw, String::new()),
+                    };
+                    drawings.push(Drawing {
+                        mesh,
+                        title: format!("{label}{name} · {clusters}{cache} ACMR {}", axes::number(recorded)),
+                        triangles,
+                        kind: content,
+                    });
                 }
             }
         }
@@ -138,15 +184,21 @@ fn short(model: &str) -> &str {
     model.rsplit('/').next().unwrap_or(model)
 }
 
+/// An order as saved: triangle ids in draw order and where its clusters start.
+struct Saved {
+    order: Vec<u32>,
+    starts: Vec<usize>,
+}
+
 /// The orders file, by (model, method), each in position order.
-fn read_orders(path: &Path) -> Result<HashMap<(String, String), Vec<u32>>> {
+fn read_orders(path: &Path) -> Result<HashMap<(String, String), Saved>> {
     let mut reader = csv::Reader::from_path(path).map_err(|e| {
         Error::input(
             path.display(),
             format!("cannot read the orders ({e}); run the experiment first (`triorder run SPEC`)"),
         )
     })?;
-    let mut orders: HashMap<(String, String), Vec<u32>> = HashMap::new();
+    let mut orders: HashMap<(String, String), Saved> = HashMap::new();
     for (i, row) in reader.deserialize::<OrderRow>().enumerate() {
         let line = i + 2;
         let row = row.map_err(|e| Error::input(path.display(), format!("line {line}: {e}")))?;
@@ -156,7 +208,19 @@ fn read_orders(path: &Path) -> Result<HashMap<(String, String), Vec<u32>>> {
             .map(|t| t.parse::<u32>())
             .collect::<std::result::Result<Vec<_>, _>>()
             .map_err(|e| Error::input(path.display(), format!("line {line}: a triangle id that is not one: {e}")))?;
-        if orders.insert((row.model, row.method), order).is_some() {
+        let starts = row
+            .clusters
+            .split_whitespace()
+            .map(|t| t.parse::<usize>())
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(|e| Error::input(path.display(), format!("line {line}: a cluster start that is not one: {e}")))?;
+        let tiled = starts.first() == Some(&0)
+            && starts.last() == Some(&order.len())
+            && starts.windows(2).all(|w| w[0] <= w[1]);
+        if !tiled {
+            return Err(Error::input(path.display(), format!("line {line}: the cluster starts do not tile the order")));
+        }
+        if orders.insert((row.model, row.method), Saved { order, starts }).is_some() {
             return Err(Error::input(
                 path.display(),
                 format!("line {line}: a second order for the same model and method"),
@@ -230,8 +294,8 @@ fn render(spec: &Spec, quick: bool, drawings: &[Drawing]) -> std::result::Result
     }
     let mut images = String::new();
     for ((drawing, place), &(left, top)) in drawings.iter().zip(&placements).zip(&origins) {
-        if let Content::Corners(classes) = &drawing.kind {
-            images.push_str(&corner_image(drawing, classes, place, (left + MARGIN, top + TITLE_H))?);
+        if !matches!(drawing.kind, Content::Sequence { .. }) {
+            images.push_str(&mesh_image(drawing, place, (left + MARGIN, top + TITLE_H))?);
         }
     }
     let mut svg = String::new();
@@ -292,27 +356,35 @@ fn sequence(
     Ok(())
 }
 
-/// The corner picture as an `<image>` element: each visible pixel takes the colour of the corner
-/// of its triangle it lies nearest (largest barycentric weight), shaded by the facet's angle to
-/// the view, with triangle borders darkened.
-fn corner_image(
-    drawing: &Drawing,
-    classes: &[[Corner; 3]],
-    place: &Placement,
-    (ox, oy): (u32, u32),
-) -> std::result::Result<String, String> {
+/// The mesh as the CPU rasterizer sees it, as an `<image>` element. Corners: each visible pixel
+/// takes the colour of the corner of its triangle it lies nearest (largest barycentric weight);
+/// clusters: its cluster's colour; both shaded by the facet's angle to the view and darkened along
+/// triangle (corners) or cluster (clusters) borders. Overdraw: the grey of the number of fragments
+/// shaded at the pixel in draw order, lightly shaded so the shape reads.
+fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std::result::Result<String, String> {
     // The rasterizer draws the NDC square [-1, 1]²; choose its size so the mesh's box gets
     // OVERSAMPLE pixels per SVG pixel, then crop to that box.
     let span = (place.hi - place.lo).max(Vec2::splat(1e-6));
     let res = ((OVERSAMPLE * place.width as f32 * 2.0 / span.x).ceil() as u32).clamp(16, cpu::MAX_RESOLUTION);
-    let ids = cpu::visible_triangles(&drawing.mesh.positions, &drawing.triangles, &place.camera, res)
-        .map_err(|e| e.to_string())?;
+    let positions = &drawing.mesh.positions;
+    let ids = cpu::visible_triangles(positions, &drawing.triangles, &place.camera, res).map_err(|e| e.to_string())?;
+    let n = res as usize;
+    let shaded = match drawing.kind {
+        Content::Overdraw => {
+            let mut fragments = Vec::new();
+            cpu::fragments(positions, &drawing.triangles, &place.camera, res, &mut fragments)
+                .map_err(|e| e.to_string())?;
+            let mut shaded = vec![0u32; n * n];
+            fragments.iter().filter(|f| f.passed).for_each(|f| shaded[f.pixel as usize] += 1);
+            shaded
+        }
+        _ => Vec::new(),
+    };
     let to_px = |v: f32| ((v + 1.0) * 0.5 * res as f32).clamp(0.0, res as f32);
     let (x0, x1) = (to_px(place.lo.x).floor() as usize, to_px(place.hi.x).ceil() as usize);
     let (y0, y1) = (to_px(place.lo.y).floor() as usize, to_px(place.hi.y).ceil() as usize);
     let (w, h) = (x1.saturating_sub(x0).max(1), y1.saturating_sub(y0).max(1));
-    let projected: Vec<Vec2> = drawing.mesh.positions.iter().map(|&p| ndc(&place.camera, p)).collect();
-    let n = res as usize;
+    let projected: Vec<Vec2> = positions.iter().map(|&p| ndc(&place.camera, p)).collect();
     let id = |x: usize, y: usize| if x < n && y < n { ids[y * n + x] } else { u32::MAX };
     let mut rgb = vec![255u8; w * h * 3];
     for row in 0..h {
@@ -324,22 +396,43 @@ fn corner_image(
                 continue;
             }
             let tri = drawing.triangles[t as usize];
-            let p = Vec2::new((x as f32 + 0.5) / res as f32 * 2.0 - 1.0, (y as f32 + 0.5) / res as f32 * 2.0 - 1.0);
-            let [a, b, c] = tri.map(|v| projected[v as usize]);
-            let area = (b - a).perp_dot(c - a);
-            let weights =
-                [(c - b).perp_dot(p - b) / area, (a - c).perp_dot(p - c) / area, (b - a).perp_dot(p - a) / area];
-            let corner = (0..3).max_by(|&i, &j| weights[i].total_cmp(&weights[j])).unwrap_or(0);
-            let base = match classes[t as usize][corner] {
-                Corner::Hit => HIT,
-                Corner::Miss(1) => FIRST_LOAD,
-                Corner::Miss(2) => RELOAD,
-                Corner::Miss(_) => LATER_RELOAD,
+            let (base, border) = match &drawing.kind {
+                Content::Corners(classes) => {
+                    let p =
+                        Vec2::new((x as f32 + 0.5) / res as f32 * 2.0 - 1.0, (y as f32 + 0.5) / res as f32 * 2.0 - 1.0);
+                    let [a, b, c] = tri.map(|v| projected[v as usize]);
+                    let area = (b - a).perp_dot(c - a);
+                    let weights = [
+                        (c - b).perp_dot(p - b) / area,
+                        (a - c).perp_dot(p - c) / area,
+                        (b - a).perp_dot(p - a) / area,
+                    ];
+                    let corner = (0..3).max_by(|&i, &j| weights[i].total_cmp(&weights[j])).unwrap_or(0);
+                    let base = match classes[t as usize][corner] {
+                        Corner::Hit => HIT,
+                        Corner::Miss(1) => FIRST_LOAD,
+                        Corner::Miss(2) => RELOAD,
+                        Corner::Miss(_) => LATER_RELOAD,
+                    };
+                    (base, id(x + 1, y) != t || id(x, y + 1) != t)
+                }
+                Content::Clusters(colours) => {
+                    let cluster = |t: u32| colours.get(t as usize).map(|c| c.1);
+                    let here = cluster(t);
+                    (colours[t as usize].0, cluster(id(x + 1, y)) != here || cluster(id(x, y + 1)) != here)
+                }
+                Content::Overdraw => {
+                    let k = (shaded[y * n + x] as usize).clamp(1, OVERDRAW_GREYS.len());
+                    ([OVERDRAW_GREYS[k - 1]; 3], false)
+                }
+                Content::Sequence { .. } => unreachable!("sequences are drawn as polygons"),
             };
-            let [pa, pb, pc] = tri.map(|v| drawing.mesh.positions[v as usize]);
+            let [pa, pb, pc] = tri.map(|v| positions[v as usize]);
             let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
-            let mut shade = 0.5 + 0.5 * normal.dot(-place.camera.forward).abs();
-            if id(x + 1, y) != t || id(x, y + 1) != t {
+            // Overdraw greys carry the data, so their facets are shaded only lightly.
+            let relief = if matches!(drawing.kind, Content::Overdraw) { 0.15 } else { 0.5 };
+            let mut shade = 1.0 - relief + relief * normal.dot(-place.camera.forward).abs();
+            if border {
                 shade *= 0.6;
             }
             let out = &mut rgb[(row * w + col) * 3..][..3];
@@ -373,21 +466,39 @@ fn legend(root: &super::axes::Area, kind: &Content, y: i32) -> DrawResult {
             &style,
             (12, y),
         ),
-        Content::Corners(_) => {
-            let entries = [
+        Content::Corners(_) => swatches(
+            root,
+            y,
+            &[
                 (HIT, "hit"),
                 (FIRST_LOAD, "first load (one per vertex)"),
                 (RELOAD, "first reload"),
                 (LATER_RELOAD, "second or later reload"),
-            ];
-            let mut x = 12;
-            for (color, label) in entries {
-                let [r, g, b] = color;
-                root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], RGBColor(r, g, b).filled()))?;
-                root.draw_text(label, &style, (x + 20, y))?;
-                x += 44 + axes::text_width(label, 13.0);
-            }
-            Ok(())
+            ],
+        ),
+        Content::Clusters(colours) if colours.first().is_some_and(|c| c.0 == [0, 0, 0]) => swatches(
+            root,
+            y,
+            &[([0, 0, 0], "first cluster drawn"), ([128, 128, 128], "…"), ([255, 255, 255], "last cluster drawn")],
+        ),
+        Content::Clusters(_) => root.draw_text("colour: cluster (facets shaded by angle to the view)", &style, (12, y)),
+        Content::Overdraw => {
+            let labels = ["1 fragment shaded", "2", "3", "4", "5 or more"];
+            let entries: Vec<([u8; 3], &str)> = OVERDRAW_GREYS.iter().map(|&g| [g, g, g]).zip(labels).collect();
+            swatches(root, y, &entries)
         }
     }
+}
+
+/// A row of colour swatches with labels.
+fn swatches(root: &super::axes::Area, y: i32, entries: &[([u8; 3], &str)]) -> DrawResult {
+    let style = (FONT, 13).into_text_style(root);
+    let mut x = 12;
+    for &([r, g, b], label) in entries {
+        root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], RGBColor(r, g, b).filled()))?;
+        root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], RGBColor(90, 90, 90).stroke_width(1)))?;
+        root.draw_text(label, &style, (x + 20, y))?;
+        x += 44 + axes::text_width(label, 13.0);
+    }
+    Ok(())
 }

@@ -9,7 +9,7 @@
 
 mod axes;
 mod bar;
-mod data;
+pub(crate) mod data;
 mod distribution;
 mod drawing;
 mod table;
@@ -72,7 +72,11 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
         FigureKind::Bar => Box::new(bar::Bars::new(&panels)),
         FigureKind::Distribution => Box::new(distribution::Distribution::new(&panels)),
         FigureKind::Table => Box::new(table::Tables(bar::Bars::new(&panels))),
-        FigureKind::Sequence | FigureKind::Corners => return drawing::plot(spec, opts, &table),
+        FigureKind::Sequence
+        | FigureKind::Corners
+        | FigureKind::Clusters
+        | FigureKind::ClusterOrder
+        | FigureKind::Overdraw => return drawing::plot(spec, opts, &table),
     };
     let frame = frame(kind.as_ref(), figure, &csv)?;
     let mut names: Vec<String> = Vec::new();
@@ -164,7 +168,8 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path) -> Result<Frame> {
         }
         None => pad(lo, hi, figure.y_log),
     };
-    let metric = METRICS.iter().find(|m| m.name == figure.metric).map_or(figure.metric.as_str(), |m| m.label);
+    let label = |name: &str| METRICS.iter().find(|m| m.name == name).map_or(name.to_string(), |m| m.label.to_string());
+    let metric = if figure.metrics.len() == 1 { label(&figure.metric) } else { figure.metrics.join(" / ") };
     let x_desc = match (&figure.x_label, &figure.x) {
         (Some(label), _) => label.clone(),
         (None, Some(column)) => column_label(column).to_string(),
@@ -177,7 +182,7 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path) -> Result<Frame> {
         x_log: figure.x_log,
         y_log: figure.y_log,
         x_desc,
-        y_desc: figure.y_label.clone().unwrap_or_else(|| metric.to_string()),
+        y_desc: figure.y_label.clone().unwrap_or(metric),
         categories,
     })
 }

@@ -8,7 +8,9 @@
 pub mod params;
 
 mod centroid_grid;
+pub mod feedback_arc_set;
 pub(crate) mod forsyth;
+mod front_to_back;
 mod grid_walk;
 mod hilbert;
 mod hoppe;
@@ -18,8 +20,12 @@ mod meshopt_fifo;
 mod meshopt_overdraw;
 mod meshopt_vcache;
 mod mla;
+mod nehab;
+pub mod overdraw_graph;
+pub(crate) mod planar_clusters;
 mod random;
 mod recursive_cut;
+pub(crate) mod sander07;
 mod snake;
 mod strips;
 pub(crate) mod tipsify;
@@ -43,6 +49,41 @@ pub struct OrderInput<'a> {
 /// A triangle-ordering algorithm with its parameters already bound.
 pub trait Ordering: Send + Sync {
     fn order(&self, input: &OrderInput) -> Result<Order>;
+
+    /// The order with the clusters it was built from, for methods that draw clusters one after
+    /// another (figures colour them); any other method is one cluster.
+    fn clustered(&self, input: &OrderInput) -> Result<Clustered> {
+        Ok(Clustered::single(self.order(input)?))
+    }
+}
+
+/// A draw order made of clusters drawn one after another: cluster `i` is
+/// `order[starts[i]..starts[i + 1]]`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Clustered {
+    pub order: Order,
+    pub starts: Vec<usize>,
+}
+
+impl Clustered {
+    pub fn single(order: Order) -> Clustered {
+        let starts = vec![0, order.len()];
+        Clustered { order, starts }
+    }
+
+    /// The clusters drawn in the given sequence.
+    pub fn concat<'a>(clusters: impl Iterator<Item = &'a [u32]>) -> Clustered {
+        let (mut order, mut starts) = (Vec::new(), vec![0]);
+        for cluster in clusters {
+            order.extend_from_slice(cluster);
+            starts.push(order.len());
+        }
+        Clustered { order, starts }
+    }
+
+    pub fn cluster_count(&self) -> usize {
+        self.starts.len() - 1
+    }
 }
 
 /// A registered method: what `triorder methods` shows, and how to build it from checked parameters.
@@ -73,7 +114,10 @@ pub static METHODS: &[&Method] = &[
     &kcache::METHOD,
     &meshopt_vcache::METHOD,
     &meshopt_fifo::METHOD,
+    &sander07::METHOD,
     &meshopt_overdraw::METHOD,
+    &nehab::METHOD,
+    &front_to_back::METHOD,
 ];
 
 /// A method spec resolved against the registry: ready to run, with its canonical name.
@@ -115,6 +159,21 @@ pub fn run(resolved: &Resolved, input: &OrderInput) -> Result<Order> {
         Error::usage(format!("internal error: `{}` returned an invalid order: {why}", resolved.canonical()))
     })?;
     Ok(order)
+}
+
+/// [`run`] keeping the clusters, checked too: they must tile the order.
+pub fn run_clustered(resolved: &Resolved, input: &OrderInput) -> Result<Clustered> {
+    let clustered = resolved.ordering.clustered(input)?;
+    let n = input.mesh.triangle_count();
+    let tiled = clustered.starts.first() == Some(&0)
+        && clustered.starts.last() == Some(&n)
+        && clustered.starts.windows(2).all(|w| w[0] <= w[1]);
+    check_permutation(&clustered.order, n)
+        .and_then(|()| if tiled { Ok(()) } else { Err("its clusters do not tile the order".into()) })
+        .map_err(|why| {
+            Error::usage(format!("internal error: `{}` returned an invalid order: {why}", resolved.canonical()))
+        })?;
+    Ok(clustered)
 }
 
 /// Ok when `order` holds each of `0..n` exactly once.

@@ -64,7 +64,7 @@ impl RasterBackend for CpuRaster {
                 || (Vec::new(), Vec::new()),
                 |(screen, depth), (i, camera)| {
                     project(positions, camera, res, screen).map_err(|why| Error::usage(format!("view {i}: {why}")))?;
-                    Ok(draw(screen, triangles, res, depth, |_, _| {}))
+                    Ok(draw(screen, triangles, res, depth, |_| {}))
                 },
             )
             .collect()
@@ -79,8 +79,41 @@ pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Ca
     let mut screen = Vec::new();
     project(positions, camera, res, &mut screen).map_err(Error::usage)?;
     let mut seen = vec![u32::MAX; res as usize * res as usize];
-    draw(&screen, triangles, res, &mut Vec::new(), |pixel, t| seen[pixel] = t as u32);
+    draw(&screen, triangles, res, &mut Vec::new(), |f| {
+        if f.passed {
+            seen[f.pixel as usize] = f.triangle
+        }
+    });
     Ok(seen)
+}
+
+/// One front-facing fragment: which pixel, which triangle (index into the drawn list), its depth,
+/// and whether it passed the depth test when the list was drawn in order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fragment {
+    pub pixel: u32,
+    pub triangle: u32,
+    pub depth: f32,
+    pub passed: bool,
+}
+
+/// Every front-facing fragment of `triangles` seen by `camera`, in draw order, appended to `out`
+/// (cleared first), under exactly the rules [`CpuRaster`] counts by. With the fragments of a view
+/// in hand, the depth test of *any* other draw order can be replayed without rasterizing again,
+/// which is what makes the one-pass cluster overdraw graph possible.
+pub fn fragments(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    camera: &Camera,
+    res: u32,
+    out: &mut Vec<Fragment>,
+) -> Result<()> {
+    check_resolution(res)?;
+    let mut screen = Vec::new();
+    project(positions, camera, res, &mut screen).map_err(Error::usage)?;
+    out.clear();
+    draw(&screen, triangles, res, &mut Vec::new(), |f| out.push(f));
+    Ok(())
 }
 
 /// An image side the rasterizer can draw: 1 to [`MAX_RESOLUTION`] pixels.
@@ -139,14 +172,14 @@ impl Edge {
     }
 }
 
-/// Draws `triangles` in order into a cleared depth buffer and counts; `on_pass(pixel, t)` sees
-/// each fragment of the `t`-th triangle that passes the depth test (a no-op closure compiles away).
+/// Draws `triangles` in order into a cleared depth buffer and counts; `on_fragment` sees every
+/// front-facing fragment, passed or not (a no-op closure compiles away).
 fn draw(
     v: &[ScreenVertex],
     triangles: &[[u32; 3]],
     res: u32,
     depth: &mut Vec<f32>,
-    mut on_pass: impl FnMut(usize, usize),
+    mut on_fragment: impl FnMut(Fragment),
 ) -> ViewCounts {
     let n = res as usize;
     depth.clear();
@@ -188,12 +221,13 @@ fn draw(
                     counts.fragments += 1;
                     let z = zy + dzdx * (x as f32 + 0.5 - ax);
                     let d = &mut depth[row + x as usize];
-                    if z < *d {
+                    let passed = z < *d;
+                    if passed {
                         counts.covered += u64::from(*d == 1.0);
                         *d = z;
                         counts.passed += 1;
-                        on_pass(row + x as usize, t);
                     }
+                    on_fragment(Fragment { pixel: (row + x as usize) as u32, triangle: t as u32, depth: z, passed });
                 }
                 e0 += edges[0].step_x;
                 e1 += edges[1].step_x;

@@ -1,0 +1,51 @@
+//! `front-to-back`: triangles sorted nearest first for one view direction, the view-dependent
+//! ideal that Nehab, Barczak & Sander 2006 (§1, Fig. 1a) compare with: least overdraw from that
+//! view, poor vertex locality. The direction points from the model towards the eye, as figure
+//! views do; triangles are sorted by decreasing centroid projection on it (stable, so ties keep
+//! the input order).
+
+use glam::Vec3;
+
+use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use crate::error::{Error, Result};
+
+const COMPONENT: ParamKind = ParamKind::Float { min: -1e6, max: 1e6 };
+
+pub static METHOD: Method = Method {
+    name: "front-to-back",
+    summary: "view-dependent: triangles sorted nearest first for one view direction",
+    source: "Nehab, Barczak & Sander 2006, §1 and Fig. 1a (the depth-sorted reference)",
+    peer: false,
+    params: &[
+        ParamInfo { name: "x", default: "0", kind: COMPONENT, help: "view direction (model → eye), x" },
+        ParamInfo { name: "y", default: "0", kind: COMPONENT, help: "view direction, y" },
+        ParamInfo { name: "z", default: "1", kind: COMPONENT, help: "view direction, z" },
+    ],
+    build,
+};
+
+fn build(params: &Params) -> Box<dyn Ordering> {
+    let d = ["x", "y", "z"].map(|k| params.float(k) as f32);
+    Box::new(FrontToBack { direction: Vec3::from_array(d) })
+}
+
+struct FrontToBack {
+    direction: Vec3,
+}
+
+impl Ordering for FrontToBack {
+    fn order(&self, input: &OrderInput) -> Result<Order> {
+        let direction = self.direction.try_normalize().ok_or_else(|| {
+            Error::usage("method `front-to-back`: the view direction x, y, z must not be zero".to_string())
+        })?;
+        let mesh = input.mesh;
+        let depth: Vec<f32> = mesh
+            .triangles
+            .iter()
+            .map(|t| t.iter().map(|&v| mesh.positions[v as usize].dot(direction)).sum::<f32>())
+            .collect();
+        let mut order: Order = (0..mesh.triangle_count() as u32).collect();
+        order.sort_by(|&a, &b| depth[b as usize].total_cmp(&depth[a as usize]));
+        Ok(order)
+    }
+}
