@@ -15,6 +15,9 @@
 //!   adjacency inside the call; our orderings get it from the mesh's [`Topology`], built once per
 //!   mesh for every method. The first row of each pair times the ordering as triorder runs it; the
 //!   `+ adjacency` row adds building that adjacency, the like-for-like comparison.
+//!   `sander07` (Tipsify, fast linear clustering with λ = 0.85, dot-rule sort) is timed against
+//!   `optimizeVertexCache` followed by `optimizeOverdraw` (threshold 1.05), meshoptimizer's take
+//!   on the same paper; their overdraw is compared in the experiments (it needs rendering).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -24,6 +27,7 @@ use crate::metrics::cache::{CacheModel, simulate};
 use crate::order::{
     self, OrderInput,
     forsyth::{Scores, forsyth},
+    sander07::sander07,
     tipsify::tipsify,
 };
 use crate::peer;
@@ -184,10 +188,27 @@ pub fn compare_orderings(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
             &mut || drop(black_box(forsyth(black_box(triangles), &vertex_triangles(mesh), 32, Scores::Tuned))),
         ],
     );
+    let positions = peer::positions(mesh);
+    let overdraw_theirs = || {
+        let mut indices = meshopt::optimize_vertex_cache(&indices, n);
+        meshopt::optimize_overdraw_in_place(&mut indices, &positions, 1.05);
+        indices
+    };
+    let overdraw_acmr = (ours_acmr("sander07:cache=16,lambda=0.85"), theirs_acmr(overdraw_theirs()));
+    let [overdraw_theirs, sander_ours, sander_with_adjacency] = median_interleaved(
+        reps,
+        [
+            &mut || drop(black_box(overdraw_theirs())),
+            &mut || drop(black_box(sander07(black_box(mesh), &topology.vertex_triangles, 16, 0.85))),
+            &mut || drop(black_box(sander07(black_box(mesh), &vertex_triangles(mesh), 16, 0.85))),
+        ],
+    );
     vec![
         row("tipsify:cache=16 vs optimizeVertexCacheFifo(16)", ours, fifo_theirs, fifo_acmr),
         row("  the same, + adjacency", with_adjacency, fifo_theirs, fifo_acmr),
         row("forsyth:cache=32 vs optimizeVertexCache", forsyth_ours, vcache_theirs, vcache_acmr),
         row("  the same, + adjacency", forsyth_with_adjacency, vcache_theirs, vcache_acmr),
+        row("sander07 vs optimizeVertexCache+Overdraw(1.05)", sander_ours, overdraw_theirs, overdraw_acmr),
+        row("  the same, + adjacency", sander_with_adjacency, overdraw_theirs, overdraw_acmr),
     ]
 }

@@ -197,9 +197,8 @@ fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
             let overdraw = direct.measurement.overdraw.as_ref().unwrap();
             let visible: Vec<_> =
                 overdraw.per_view.iter().enumerate().filter_map(|(i, v)| Some((i, v.ovr()?))).collect();
-            for &(i, ovr) in &visible {
-                assert_eq!(value("ovr", "", &i.to_string()), ovr);
-            }
+            // The figure draws ACMR, so the per-view ratios are summarised, not written.
+            assert!(mine.iter().all(|r| r["metric"] != "ovr"));
             assert_eq!(value("ovr_empty", "", "") as usize, 6 - visible.len());
             let summary = overdraw.summary.unwrap();
             assert_eq!(value("ovr_mean", "", ""), summary.mean);
@@ -210,8 +209,8 @@ fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
             assert_eq!((r["method_name"].as_str(), r["seed"].as_str()), (method.split(':').next().unwrap(), "3"));
             assert_eq!((r["backend"].as_str(), r["triorder"].as_str()), ("cpu", env!("CARGO_PKG_VERSION")));
             assert!(!r["machine"].is_empty() && !r["commit"].is_empty());
-            // 3 caches × (acmr, atvr) + seconds + ovr_empty + 5 summaries + one row per visible view.
-            assert_eq!(mine.len(), 3 * 2 + 1 + 1 + 5 + visible.len());
+            // 3 caches × (acmr, atvr) + seconds + ovr_empty + 5 summaries.
+            assert_eq!(mine.len(), 3 * 2 + 1 + 1 + 5);
             expected_rows += mine.len();
         }
     }
@@ -234,6 +233,47 @@ fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
         "sphere:80 (80 triangles)",
     ] {
         assert!(text.contains(want), "SVG lacks `{want}`");
+    }
+}
+
+/// A figure that draws the per-view ratios gets one `ovr` row per visible view, equal to what
+/// `evaluate` measures.
+#[test]
+fn per_view_rows_are_written_when_the_figure_draws_them() {
+    let root = tempfile::tempdir().unwrap();
+    let text = TINY.replace("id = \"tiny\"", "id = \"spread\"").replace(
+        "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
+        "kind = \"distribution\"\nmetric = \"ovr\"\nfacet = \"model\"",
+    );
+    let path = write_spec(root.path(), "spread", &text);
+    let (_, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
+    let spec = Spec::load(&path).unwrap();
+    let work = spec.workload(true).unwrap();
+    let options = MeasureOptions { caches: vec![], views: work.views, res: work.res, seed: spec.seed };
+    for model in &work.models {
+        let mesh = source::open(model, None, spec.seed).unwrap();
+        let topology = Topology::new(&mesh);
+        for method in &spec.methods {
+            let resolved = order::resolve(method, spec.seed).unwrap();
+            let direct = evaluate(&mesh, &topology, &resolved, &options, raster::backend("cpu").unwrap().as_ref());
+            let expected: Vec<(String, f64)> = direct
+                .unwrap()
+                .measurement
+                .overdraw
+                .unwrap()
+                .per_view
+                .iter()
+                .enumerate()
+                .filter_map(|(i, v)| Some((i.to_string(), v.ovr()?)))
+                .collect();
+            let written: Vec<(String, f64)> = rows
+                .iter()
+                .filter(|r| r["model"] == *model && r["method"] == *method && r["metric"] == "ovr")
+                .map(|r| (r["view"].clone(), r["value"].parse().unwrap()))
+                .collect();
+            assert!(!written.is_empty());
+            assert_eq!(written, expected, "{model} {method}");
+        }
     }
 }
 

@@ -55,7 +55,7 @@ pub struct Metric {
 
 /// Every metric a run writes. Cache metrics come once per cache model; overdraw summaries once
 /// per view set; `ovr` once per view that sees the mesh (empty views have no ratio and are
-/// counted by `ovr_empty` instead).
+/// counted by `ovr_empty` instead), and only when the spec's figure draws `ovr`.
 pub const METRICS: &[Metric] = &[
     Metric { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: Needs::Caches },
     Metric { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: Needs::Caches },
@@ -108,6 +108,10 @@ pub struct Context {
     pub backend: String,
     pub machine: String,
     pub commit: String,
+    /// Whether to write the per-view `ovr` rows: only when the figure draws them. They are
+    /// one row per view per (model, method), which would make a 162-view run of every method
+    /// on every model an 8 MB file, while the summaries are what the other figures read.
+    pub per_view: bool,
 }
 
 impl Context {
@@ -163,7 +167,7 @@ impl Context {
                     rows.push(Row { metric, value, ..views.clone() });
                 }
             }
-            for (i, counts) in overdraw.per_view.iter().enumerate() {
+            for (i, counts) in overdraw.per_view.iter().enumerate().filter(|_| self.per_view) {
                 if let Some(value) = counts.ovr() {
                     rows.push(Row { metric: "ovr", view: Some(i), value, ..views.clone() });
                 }

@@ -105,6 +105,7 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
         backend: spec.backend.clone(),
         machine: provenance::machine(),
         commit: provenance::commit(),
+        per_view: spec.figure.metrics.iter().any(|m| m == "ovr"),
     };
 
     let bar = bars.add(ProgressBar::new((work.models.len() * methods.len()) as u64));

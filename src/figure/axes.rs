@@ -123,7 +123,7 @@ where
 /// lasts.
 pub struct Colors(Vec<(String, RGBColor)>);
 
-const PALETTE: [RGBColor; 16] = [
+const PALETTE: [RGBColor; 20] = [
     RGBColor(0x4d, 0x4d, 0x4d), // grey
     RGBColor(0xe1, 0x57, 0x59), // red
     RGBColor(0x4e, 0x79, 0xa7), // blue
@@ -140,6 +140,10 @@ const PALETTE: [RGBColor; 16] = [
     RGBColor(0x1b, 0x6e, 0x3b), // dark green
     RGBColor(0x1f, 0x3a, 0x93), // navy
     RGBColor(0xe3, 0x77, 0xc2), // magenta
+    RGBColor(0x8c, 0x8c, 0x00), // olive
+    RGBColor(0x00, 0x80, 0x80), // dark teal
+    RGBColor(0xc0, 0x40, 0x00), // rust
+    RGBColor(0x99, 0x99, 0xff), // lavender
 ];
 
 impl Colors {

@@ -23,6 +23,8 @@ use glam::{DVec3, Vec3};
 use super::tipsify::{FIFO_CACHE, tipsify};
 use super::{Clustered, Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
 use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::topology::Csr;
 
 pub static METHOD: Method = Method {
     name: "sander07",
@@ -56,13 +58,17 @@ impl Ordering for Sander07 {
     }
 
     fn clustered(&self, input: &OrderInput) -> Result<Clustered> {
-        let mesh = input.mesh;
-        let (order, dead_ends) = tipsify(&mesh.triangles, &input.topology.vertex_triangles, self.cache);
-        let starts = linear_clusters(&mesh.triangles, &order, &dead_ends, mesh.vertex_count(), self.cache, self.lambda);
-        let clusters: Vec<&[u32]> = starts.windows(2).map(|w| &order[w[0]..w[1]]).collect();
-        let sorted = dot_rule_sort(&mesh.positions, &mesh.triangles, &clusters);
-        Ok(Clustered::concat(sorted.iter().map(|&c| clusters[c])))
+        Ok(sander07(input.mesh, &input.topology.vertex_triangles, self.cache, self.lambda))
     }
+}
+
+/// The whole pipeline on `mesh`, whose vertex→triangle adjacency is `vertex_triangles`.
+pub(crate) fn sander07(mesh: &Mesh, vertex_triangles: &Csr, cache: u32, lambda: f64) -> Clustered {
+    let (order, dead_ends) = tipsify(&mesh.triangles, vertex_triangles, cache);
+    let starts = linear_clusters(&mesh.triangles, &order, &dead_ends, mesh.vertex_count(), cache, lambda);
+    let clusters: Vec<&[u32]> = starts.windows(2).map(|w| &order[w[0]..w[1]]).collect();
+    let sorted = dot_rule_sort(&mesh.positions, &mesh.triangles, &clusters);
+    Clustered::concat(sorted.iter().map(|&c| clusters[c]))
 }
 
 /// Cluster starts (ending with `order.len()`) of the fast linear clustering of `order`, a Tipsify
