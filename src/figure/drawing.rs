@@ -202,22 +202,16 @@ fn read_orders(path: &Path) -> Result<HashMap<(String, String), Saved>> {
     for (i, row) in reader.deserialize::<OrderRow>().enumerate() {
         let line = i + 2;
         let row = row.map_err(|e| Error::input(path.display(), format!("line {line}: {e}")))?;
-        let order = row
-            .order
-            .split_whitespace()
-            .map(|t| t.parse::<u32>())
-            .collect::<std::result::Result<Vec<_>, _>>()
-            .map_err(|e| Error::input(path.display(), format!("line {line}: a triangle id that is not one: {e}")))?;
-        let starts = row
-            .clusters
-            .split_whitespace()
-            .map(|t| t.parse::<usize>())
-            .collect::<std::result::Result<Vec<_>, _>>()
-            .map_err(|e| Error::input(path.display(), format!("line {line}: a cluster start that is not one: {e}")))?;
-        let tiled = starts.first() == Some(&0)
-            && starts.last() == Some(&order.len())
-            && starts.windows(2).all(|w| w[0] <= w[1]);
-        if !tiled {
+        let words = |text: &str, what: &str| {
+            text.split_whitespace().map(str::parse).collect::<std::result::Result<Vec<_>, _>>().map_err(
+                |e: std::num::ParseIntError| {
+                    Error::input(path.display(), format!("line {line}: {what} that is not one: {e}"))
+                },
+            )
+        };
+        let order: Vec<u32> = words(&row.order, "a triangle id")?;
+        let starts: Vec<usize> = words(&row.clusters, "a cluster start")?.into_iter().map(|s| s as usize).collect();
+        if !order::tiles(&starts, order.len()) {
             return Err(Error::input(path.display(), format!("line {line}: the cluster starts do not tile the order")));
         }
         if orders.insert((row.model, row.method), Saved { order, starts }).is_some() {

@@ -165,15 +165,20 @@ pub fn run(resolved: &Resolved, input: &OrderInput) -> Result<Order> {
 pub fn run_clustered(resolved: &Resolved, input: &OrderInput) -> Result<Clustered> {
     let clustered = resolved.ordering.clustered(input)?;
     let n = input.mesh.triangle_count();
-    let tiled = clustered.starts.first() == Some(&0)
-        && clustered.starts.last() == Some(&n)
-        && clustered.starts.windows(2).all(|w| w[0] <= w[1]);
     check_permutation(&clustered.order, n)
-        .and_then(|()| if tiled { Ok(()) } else { Err("its clusters do not tile the order".into()) })
+        .and_then(
+            |()| if tiles(&clustered.starts, n) { Ok(()) } else { Err("its clusters do not tile the order".into()) },
+        )
         .map_err(|why| {
             Error::usage(format!("internal error: `{}` returned an invalid order: {why}", resolved.canonical()))
         })?;
     Ok(clustered)
+}
+
+/// True when cluster `starts` cut an order of `n` triangles into consecutive runs: from 0 to `n`,
+/// never decreasing.
+pub fn tiles(starts: &[usize], n: usize) -> bool {
+    starts.first() == Some(&0) && starts.last() == Some(&n) && starts.windows(2).all(|w| w[0] <= w[1])
 }
 
 /// Ok when `order` holds each of `0..n` exactly once.
