@@ -6,6 +6,7 @@
 //! reading; [`Mesh::new`] re-checks the invariants every other module relies on (finite
 //! coordinates, indices in range, at least one triangle) so no later stage has to.
 
+pub mod animated;
 pub mod gltf;
 pub mod load;
 pub mod obj;
