@@ -9,9 +9,11 @@
 //! check). Three more inputs make the `gltf` crate itself panic, so they are refused before it
 //! sees them: a GLB header whose length field is below 12, a `POSITION` accessor index past the
 //! end (its validator indexes without checking), and a buffer URI whose percent-escapes are not
-//! UTF-8.
+//! UTF-8. [`super::gltf_animation`] reads skins and animations with the same pieces (parsing,
+//! accessors, hierarchy, primitives), so its rest mesh is this reader's mesh before posing.
 
-use std::collections::BTreeSet;
+use std::collections::hash_map::Entry;
+use std::collections::{BTreeSet, HashMap};
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -39,6 +41,31 @@ use crate::mesh::{Mesh, NamedAttribute, VertexAttributes};
 /// attribute `NAME`), each kept only if every primitive has it.
 pub fn read(bytes: &[u8], origin: &str, base: Option<&Path>, binary: bool) -> Result<(Mesh, LoadReport)> {
     let fail = |problem: String| Error::input(origin, problem);
+    let (document, buffers) = open(bytes, origin, base, binary)?;
+    let mut report = LoadReport::default();
+    let world = world_transforms(&document).map_err(fail)?;
+    let mut skins: HashMap<usize, Vec<Mat4>> = HashMap::new();
+    let mut parts = Vec::new();
+    for ScenePart { node, at, part, .. } in scene_parts(&document, &buffers, &mut report).map_err(fail)? {
+        parts.push(match node.skin() {
+            Some(skin) => {
+                let joints = match skins.entry(skin.index()) {
+                    Entry::Occupied(known) => known.into_mut(),
+                    Entry::Vacant(slot) => slot.insert(joint_matrices(&skin, &world, &buffers).map_err(fail)?),
+                };
+                part.skinned(joints, &at).map_err(fail)?
+            }
+            None => part.transformed(world[node.index()]),
+        });
+    }
+    let (positions, triangles, attributes) = merge(parts, &mut report);
+    Ok((Mesh::new(origin, positions, triangles, attributes)?, report))
+}
+
+/// Parses a glTF or GLB file and loads its buffers, refusing first the inputs that make the
+/// `gltf` crate panic. Arguments as for [`read`].
+pub(super) fn open(bytes: &[u8], origin: &str, base: Option<&Path>, binary: bool) -> Result<(Document, Vec<Vec<u8>>)> {
+    let fail = |problem: String| Error::input(origin, problem);
     if binary || bytes.starts_with(b"glTF") {
         check_glb_header(bytes).map_err(fail)?;
     } else if bytes.is_empty() {
@@ -49,17 +76,30 @@ pub fn read(bytes: &[u8], origin: &str, base: Option<&Path>, binary: bool) -> Re
     check_position_indices(&gltf.document).map_err(fail)?;
     let document = Document::from_json(gltf.document.into_json()).map_err(|e| fail(e.to_string()))?;
     let buffers = load_buffers(&document, base, blob).map_err(fail)?;
+    Ok((document, buffers))
+}
 
-    let mut report = LoadReport::default();
+/// One triangle primitive of a mesh node of the scene, read but not yet placed.
+pub(super) struct ScenePart<'a> {
+    pub(super) node: ::gltf::Node<'a>,
+    pub(super) primitive: ::gltf::Primitive<'a>,
+    /// "mesh M primitive P", to name the primitive in errors.
+    pub(super) at: String,
+    pub(super) part: Part,
+}
+
+/// Every triangle primitive of every mesh node of the scene, in node and primitive order, with
+/// its skinning attributes if its node has a skin. Point and line primitives, and attributes not
+/// loaded, are noted in `report`. Fails if no primitive has a triangle.
+pub(super) fn scene_parts<'a>(
+    document: &'a Document,
+    buffers: &[Vec<u8>],
+    report: &mut LoadReport,
+) -> std::result::Result<Vec<ScenePart<'a>>, String> {
     let mut parts = Vec::new();
     let mut unloaded = BTreeSet::new();
-    let world = world_transforms(&document).map_err(fail)?;
-    for node in scene_nodes(&document).map_err(fail)? {
+    for node in scene_nodes(document)? {
         let Some(mesh) = node.mesh() else { continue };
-        let joints = match node.skin() {
-            Some(skin) => Some(joint_matrices(&skin, &world, &buffers).map_err(fail)?),
-            None => None,
-        };
         for primitive in mesh.primitives() {
             let at = format!("mesh {} primitive {}", mesh.index(), primitive.index());
             match primitive.mode() {
@@ -69,22 +109,18 @@ pub fn read(bytes: &[u8], origin: &str, base: Option<&Path>, binary: bool) -> Re
                     continue;
                 }
             }
-            let part = Part::read(&primitive, &buffers, &at, joints.is_some(), &mut unloaded).map_err(fail)?;
-            parts.push(match &joints {
-                Some(joints) => part.skinned(joints, &at).map_err(fail)?,
-                None => part.transformed(world[node.index()]),
-            });
+            let part = Part::read(&primitive, buffers, &at, node.skin().is_some(), &mut unloaded)?;
+            parts.push(ScenePart { node: node.clone(), primitive, at, part });
         }
     }
     if !unloaded.is_empty() {
         let names: Vec<String> = unloaded.into_iter().collect();
         report.dropped.push(format!("attributes not loaded: {}", names.join(", ")));
     }
-    if parts.iter().all(|p| p.triangles.is_empty()) {
-        return Err(fail("no triangles: the scene has no triangle primitive with faces".into()));
+    if parts.iter().all(|p| p.part.triangles.is_empty()) {
+        return Err("no triangles: the scene has no triangle primitive with faces".into());
     }
-    let (positions, triangles, attributes) = merge(parts, &mut report);
-    Ok((Mesh::new(origin, positions, triangles, attributes)?, report))
+    Ok(parts)
 }
 
 /// Checks the 12-byte GLB header the `gltf` crate trusts (a length field below 12 underflows
@@ -189,65 +225,84 @@ fn percent_decodes_to_utf8(uri: &str) -> bool {
     String::from_utf8(decoded).is_ok()
 }
 
-/// Every node's world transform. glTF node hierarchies must be trees: a node with two parents
-/// would be drawn twice and a cycle has no root, so both are refused.
+/// Every node's world transform at rest.
 fn world_transforms(document: &Document) -> std::result::Result<Vec<Mat4>, String> {
-    let count = document.nodes().len();
-    let mut parent: Vec<Option<usize>> = vec![None; count];
-    let mut local = Vec::with_capacity(count);
-    for node in document.nodes() {
-        let matrix = Mat4::from_cols_array_2d(&node.transform().matrix());
-        if !matrix.is_finite() {
-            return Err(format!("node {}: its transform has a non-finite value", node.index()));
-        }
-        local.push(matrix);
-        for child in node.children() {
-            let slot = parent
-                .get_mut(child.index())
-                .ok_or_else(|| format!("node {}: no child {}", node.index(), child.index()))?;
-            if let Some(other) = slot.replace(node.index()) {
-                return Err(format!(
-                    "node {}: it is a child of both node {other} and node {}",
-                    child.index(),
-                    node.index()
-                ));
+    let hierarchy = Hierarchy::of(document)?;
+    Ok(hierarchy.world(&local_transforms(document)?))
+}
+
+/// Every node's own transform (its matrix, or its translation, rotation and scale composed).
+pub(super) fn local_transforms(document: &Document) -> std::result::Result<Vec<Mat4>, String> {
+    document
+        .nodes()
+        .map(|node| {
+            let matrix = Mat4::from_cols_array_2d(&node.transform().matrix());
+            match matrix.is_finite() {
+                true => Ok(matrix),
+                false => Err(format!("node {}: its transform has a non-finite value", node.index())),
             }
-        }
-    }
-    let mut world: Vec<Option<Mat4>> = vec![None; count];
-    for start in 0..count {
-        // Walk up to the nearest node already placed (or a root), then place the chain top-down.
-        let mut chain = vec![start];
-        let mut above = Mat4::IDENTITY;
-        while let Some(&last) = chain.last() {
-            match parent[last] {
-                Some(p) if world[p].is_none() => {
-                    if chain.len() > count {
-                        return Err(format!("node {start}: the node hierarchy has a cycle"));
-                    }
-                    chain.push(p);
+        })
+        .collect()
+}
+
+/// The node tree: each node's parent, and every node listed after its parent.
+pub(super) struct Hierarchy {
+    parent: Vec<Option<usize>>,
+    parents_first: Vec<usize>,
+}
+
+impl Hierarchy {
+    /// glTF node hierarchies must be trees: a node with two parents would be drawn twice and a
+    /// cycle has no root, so both are refused.
+    pub(super) fn of(document: &Document) -> std::result::Result<Hierarchy, String> {
+        let count = document.nodes().len();
+        let mut parent: Vec<Option<usize>> = vec![None; count];
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); count];
+        for node in document.nodes() {
+            for child in node.children() {
+                let slot = parent
+                    .get_mut(child.index())
+                    .ok_or_else(|| format!("node {}: no child {}", node.index(), child.index()))?;
+                if let Some(other) = slot.replace(node.index()) {
+                    return Err(format!(
+                        "node {}: it is a child of both node {other} and node {}",
+                        child.index(),
+                        node.index()
+                    ));
                 }
-                Some(p) => {
-                    above = world[p].unwrap_or(Mat4::IDENTITY);
-                    break;
-                }
-                None => break,
+                children[node.index()].push(child.index());
             }
         }
-        for &n in chain.iter().rev() {
-            if world[n].is_none() {
-                above *= local[n];
-                world[n] = Some(above);
-            } else {
-                above = world[n].unwrap_or(above);
-            }
+        // Every node has at most one parent, so the nodes no root reaches are on or below a cycle.
+        let mut parents_first = Vec::with_capacity(count);
+        let mut stack: Vec<usize> = (0..count).rev().filter(|&n| parent[n].is_none()).collect();
+        while let Some(n) = stack.pop() {
+            parents_first.push(n);
+            stack.extend(children[n].iter().rev());
         }
+        if parents_first.len() < count {
+            let mut reached = vec![false; count];
+            parents_first.iter().for_each(|&n| reached[n] = true);
+            let first = reached.iter().position(|&r| !r).unwrap_or_default();
+            return Err(format!("node {first}: the node hierarchy has a cycle"));
+        }
+        Ok(Hierarchy { parent, parents_first })
     }
-    Ok(world.into_iter().map(|m| m.unwrap_or(Mat4::IDENTITY)).collect())
+
+    /// The world transforms of nodes whose own transforms are `local` (one per node).
+    pub(super) fn world(&self, local: &[Mat4]) -> Vec<Mat4> {
+        let mut world = local.to_vec();
+        for &n in &self.parents_first {
+            if let Some(p) = self.parent[n] {
+                world[n] = world[p] * local[n];
+            }
+        }
+        world
+    }
 }
 
 /// The nodes of the default scene (of every scene if none is the default), parents first.
-fn scene_nodes(document: &Document) -> std::result::Result<Vec<::gltf::Node<'_>>, String> {
+pub(super) fn scene_nodes(document: &Document) -> std::result::Result<Vec<::gltf::Node<'_>>, String> {
     let scenes: Vec<::gltf::Scene<'_>> = match document.default_scene() {
         Some(scene) => vec![scene],
         None => document.scenes().collect(),
@@ -274,59 +329,67 @@ fn scene_nodes(document: &Document) -> std::result::Result<Vec<::gltf::Node<'_>>
 }
 
 /// Each joint's skinning matrix at rest: its node's world transform times its inverse bind
-/// matrix (identity when the skin gives none).
+/// matrix.
 fn joint_matrices(
     skin: &::gltf::Skin<'_>,
     world: &[Mat4],
     buffers: &[Vec<u8>],
 ) -> std::result::Result<Vec<Mat4>, String> {
-    let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
-    let inverse_bind: Vec<Mat4> = match skin.inverse_bind_matrices() {
-        Some(accessor) => {
-            if accessor.dimensions() != Dimensions::Mat4 || accessor.data_type() != DataType::F32 {
-                return Err(format!(
-                    "skin {}: inverse bind matrix accessor {} is not MAT4 of floats",
-                    skin.index(),
-                    accessor.index()
-                ));
-            }
-            if accessor.count() < joints.len() {
-                return Err(format!(
-                    "skin {}: inverse bind matrix accessor {} has {} matrices for {} joints",
-                    skin.index(),
-                    accessor.index(),
-                    accessor.count(),
-                    joints.len()
-                ));
-            }
-            let values = accessor_values(&accessor, buffers, 16)?;
-            values
-                .chunks_exact(16)
-                .map(|m| Mat4::from_cols_slice(&m.iter().map(|&v| v as f32).collect::<Vec<_>>()))
-                .collect()
-        }
-        None => vec![Mat4::IDENTITY; joints.len()],
-    };
-    Ok(joints.iter().zip(inverse_bind).map(|(&j, ibm)| world.get(j).copied().unwrap_or(Mat4::IDENTITY) * ibm).collect())
+    let inverse_bind = inverse_bind_matrices(skin, buffers)?;
+    Ok(skin
+        .joints()
+        .zip(inverse_bind)
+        .map(|(j, ibm)| world.get(j.index()).copied().unwrap_or(Mat4::IDENTITY) * ibm)
+        .collect())
+}
+
+/// A skin's inverse bind matrices, one per joint (identity when the skin gives none).
+pub(super) fn inverse_bind_matrices(
+    skin: &::gltf::Skin<'_>,
+    buffers: &[Vec<u8>],
+) -> std::result::Result<Vec<Mat4>, String> {
+    let joints = skin.joints().len();
+    let Some(accessor) = skin.inverse_bind_matrices() else { return Ok(vec![Mat4::IDENTITY; joints]) };
+    if accessor.dimensions() != Dimensions::Mat4 || accessor.data_type() != DataType::F32 {
+        return Err(format!(
+            "skin {}: inverse bind matrix accessor {} is not MAT4 of floats",
+            skin.index(),
+            accessor.index()
+        ));
+    }
+    if accessor.count() < joints {
+        return Err(format!(
+            "skin {}: inverse bind matrix accessor {} has {} matrices for {joints} joints",
+            skin.index(),
+            accessor.index(),
+            accessor.count(),
+        ));
+    }
+    let values = accessor_values(&accessor, buffers, 16)?;
+    Ok(values
+        .chunks_exact(16)
+        .take(joints)
+        .map(|m| Mat4::from_cols_slice(&m.iter().map(|&v| v as f32).collect::<Vec<_>>()))
+        .collect())
 }
 
 /// One `JOINTS_n`/`WEIGHTS_n` pair: per vertex, four joints and their weights.
-struct Influences {
-    set: u32,
-    joints: Vec<[f32; 4]>,
-    weights: Vec<[f32; 4]>,
+pub(super) struct Influences {
+    pub(super) set: u32,
+    pub(super) joints: Vec<[f32; 4]>,
+    pub(super) weights: Vec<[f32; 4]>,
 }
 
 /// One triangle primitive's vertices and triangles, before merging.
-struct Part {
-    positions: Vec<Vec3>,
+pub(super) struct Part {
+    pub(super) positions: Vec<Vec3>,
     /// For a skinned primitive, each `JOINTS_n`/`WEIGHTS_n` set.
-    influences: Vec<Influences>,
+    pub(super) influences: Vec<Influences>,
     normals: Option<Vec<[f32; 3]>>,
     uvs: Option<Vec<[f32; 2]>>,
     colors: Option<Vec<[f32; 4]>>,
     extra: Vec<NamedAttribute>,
-    triangles: Vec<[u32; 3]>,
+    pub(super) triangles: Vec<[u32; 3]>,
 }
 
 impl Part {
@@ -381,8 +444,15 @@ impl Part {
                     let values = read_vectors::<1>(&accessor, buffers, &name)?.into_iter().map(|[v]| v).collect();
                     extra.push(NamedAttribute { name: short.clone(), values });
                 }
-                Semantic::Joints(set) => joints.push((*set, read_vectors::<4>(&accessor, buffers, &name)?)),
-                Semantic::Weights(set) => weights.push((*set, read_vectors::<4>(&accessor, buffers, &name)?)),
+                // Element i is vertex i, so with the primitive named the error locates the vertex.
+                Semantic::Joints(set) => {
+                    let values = read_vectors::<4>(&accessor, buffers, &name).map_err(|e| format!("{at}: {e}"))?;
+                    joints.push((*set, values));
+                }
+                Semantic::Weights(set) => {
+                    let values = read_vectors::<4>(&accessor, buffers, &name).map_err(|e| format!("{at}: {e}"))?;
+                    weights.push((*set, values));
+                }
                 _ => {}
             }
         }
@@ -453,13 +523,19 @@ impl Part {
             for n in self.normals.iter_mut().flatten() {
                 *n = (normal_matrix * Vec3::from_array(*n)).normalize_or_zero().to_array();
             }
-            if m.determinant() < 0.0 {
-                for t in &mut self.triangles {
-                    t.swap(1, 2);
-                }
-            }
+            self.keep_front_faces(m);
         }
         self
+    }
+
+    /// Reverses every triangle's winding if `m` mirrors, so that the faces that were front
+    /// faces stay front faces once the part is placed by `m`.
+    pub(super) fn keep_front_faces(&mut self, m: Mat4) {
+        if m.determinant() < 0.0 {
+            for t in &mut self.triangles {
+                t.swap(1, 2);
+            }
+        }
     }
 }
 
@@ -485,7 +561,7 @@ fn assemble(mode: Mode, indices: &[u32]) -> std::result::Result<Vec<[u32; 3]>, S
 }
 
 /// Concatenates the parts; an attribute survives only if every part has it.
-fn merge(parts: Vec<Part>, report: &mut LoadReport) -> (Vec<Vec3>, Vec<[u32; 3]>, VertexAttributes) {
+pub(super) fn merge(parts: Vec<Part>, report: &mut LoadReport) -> (Vec<Vec3>, Vec<[u32; 3]>, VertexAttributes) {
     let total: usize = parts.iter().map(|p| p.positions.len()).sum();
     let all = |has: &dyn Fn(&Part) -> bool, what: &str, report: &mut LoadReport| {
         let count = parts.iter().filter(|p| has(p)).count();
@@ -667,7 +743,7 @@ fn accessor_values(accessor: &Accessor<'_>, buffers: &[Vec<u8>], dims: usize) ->
 }
 
 /// An attribute accessor as `N`-component float vectors (normalised if the accessor says so).
-fn read_vectors<const N: usize>(
+pub(super) fn read_vectors<const N: usize>(
     accessor: &Accessor<'_>,
     buffers: &[Vec<u8>],
     name: &str,

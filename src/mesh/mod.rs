@@ -8,6 +8,7 @@
 
 pub mod animated;
 pub mod gltf;
+pub mod gltf_animation;
 pub mod load;
 pub mod obj;
 pub mod ply;
