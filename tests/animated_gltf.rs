@@ -492,3 +492,29 @@ fn broken_skins_and_animations_are_errors_that_say_what_is_wrong() {
     let e = error(skinned_triangle(joints, weights, &[no_morphs]));
     assert!(e.contains("no morph targets"), "{e}");
 }
+
+/// Han & Sander's Table 1 rows at subdivision 1 and 2 need the subdivided character to animate:
+/// Soldier's Walk, subdivided twice, has 16× the triangles and every posed frame stays within the
+/// posed original's bounding box (Loop's stencils and the blended influences are convex
+/// combinations, up to the blend of different joints' matrices: 2% of the box allowed).
+#[test]
+fn soldier_subdivided_twice_still_walks() {
+    use triorder::mesh::subdivide::loop_subdivide;
+    let Some(path) = animated_file("Soldier.glb") else { return };
+    let walk = ClipSelection { clip: Some("Walk".into()), frames: None };
+    let animated = read_animated(&path, &walk).unwrap();
+    let fine = loop_subdivide(&animated, 2).unwrap();
+    assert_eq!(fine.mesh.triangle_count(), 16 * animated.mesh.triangle_count());
+    let bounds = |points: &[Vec3]| {
+        points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    };
+    let mut moved = false;
+    for (i, pose) in fine.clips[0].frames.iter().enumerate() {
+        let (lo, hi) = bounds(&animated.positions(&animated.clips[0].frames[i]));
+        let slack = 0.02 * (hi - lo).length();
+        let posed = fine.positions(pose);
+        assert!(posed.iter().all(|p| p.is_finite() && p.cmpge(lo - slack).all() && p.cmple(hi + slack).all()));
+        moved |= i > 0 && posed != fine.positions(&fine.clips[0].frames[0]);
+    }
+    assert!(moved, "the subdivided soldier does not move");
+}

@@ -17,6 +17,7 @@ pub mod report;
 pub mod save;
 pub mod simplify;
 pub mod source;
+pub mod subdivide;
 
 use glam::Vec3;
 
