@@ -138,6 +138,8 @@ struct ViewScratch {
     by_pixel: Vec<(u32, f32)>,
     /// Start of each pixel's bucket in `by_pixel`.
     pixel_start: Vec<u32>,
+    /// Next free slot of each pixel's bucket while filling.
+    cursor: Vec<u32>,
     /// The current pixel's clusters: `(cluster, nearest depth, range of its alone-passing depths)`.
     groups: Vec<(u32, f32, usize, usize)>,
     passing: Vec<f32>,
@@ -157,9 +159,9 @@ impl ViewScratch {
         }
         self.by_pixel.clear();
         self.by_pixel.resize(self.fragments.len(), (0, 0.0));
-        let mut cursor = self.pixel_start.clone();
+        self.cursor.clone_from(&self.pixel_start);
         for f in &self.fragments {
-            let slot = &mut cursor[f.pixel as usize];
+            let slot = &mut self.cursor[f.pixel as usize];
             self.by_pixel[*slot as usize] = (cluster_of[f.triangle as usize], f.depth);
             *slot += 1;
         }
