@@ -64,13 +64,17 @@ pub static METHOD: Method = Method {
     summary: "greedy strip growing with FIFO look-ahead (Hoppe 1999)",
     source: "Hoppe 1999, greedy strip growing; author's MeshReorder meshify5",
     peer: false,
-    params: &[ParamInfo {
-        name: "cache",
-        default: "16",
-        kind: ParamKind::Int { min: 3, max: 128 },
-        help: "FIFO size the strips are grown for (look-ahead of cache+5 faces)",
-    }],
+    params: &[CACHE],
     build,
+};
+
+/// The FIFO size parameter, shared with `nehab`, whose inner ordering it configures, so the two
+/// always accept the same sizes.
+pub(super) const CACHE: ParamInfo = ParamInfo {
+    name: "cache",
+    default: "16",
+    kind: ParamKind::Int { min: 3, max: 128 },
+    help: "FIFO size the strips are grown for (look-ahead of cache+5 faces)",
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {

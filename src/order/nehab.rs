@@ -17,6 +17,7 @@
 use rayon::prelude::*;
 
 use super::feedback_arc_set::greedy_order;
+use super::hoppe;
 use super::overdraw_graph::{ClusteredDraw, one_pass};
 use super::planar_clusters::planar_clusters;
 use super::{Clustered, Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
@@ -55,12 +56,7 @@ pub static METHOD: Method = Method {
             kind: ParamKind::Choice(&["hoppe", "tipsify"]),
             help: "locality ordering applied inside each cluster",
         },
-        ParamInfo {
-            name: "cache",
-            default: "16",
-            kind: ParamKind::Int { min: 3, max: 128 },
-            help: "FIFO size the inner ordering is tuned for",
-        },
+        ParamInfo { help: "FIFO size the inner ordering is tuned for", ..hoppe::CACHE },
         ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "picks the first cluster seed face" },
     ],
     build,
