@@ -5,8 +5,9 @@ use std::time::Instant;
 
 use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::mesh::keyframes::Keyframes;
 use crate::metrics::{CacheModel, CacheStats, OverdrawSummary, cache};
-use crate::order::{self, Order, OrderInput, Resolved};
+use crate::order::{self, NodeOrders, Order, OrderInput, Resolved};
 use crate::raster::{Framing, RasterBackend, ViewCounts, ViewSet};
 use crate::topology::Topology;
 
@@ -95,4 +96,111 @@ pub fn evaluate(
         cluster_starts: clustered.starts,
         measurement,
     })
+}
+
+/// The overdraw of one clip (or, with `clip` `None`, of every frame) over keyframes × views.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClipOverdraw {
+    pub clip: Option<String>,
+    /// `per_view` is frame-major: keyframe × view.
+    pub overdraw: Overdraw,
+}
+
+/// The metrics of index buffers drawn per (keyframe, view) as their lookup picks, measured as Han
+/// & Sander 2017 §4 do: every keyframe from every view of the set, each draw with its buffer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeMeasurement {
+    /// Per cache model: ACMR and ATVR averaged over the draws, each draw counting its buffer's
+    /// ratio (so a buffer the lookup never picks costs nothing). Without a view set there are no
+    /// draws, and each buffer counts as often as lookup cells pick it.
+    pub caches: Vec<(CacheModel, f64, f64)>,
+    /// All frames first, then each clip when there are several; empty without a view set.
+    pub overdraw: Vec<ClipOverdraw>,
+}
+
+/// Measures `nodes`, index buffers for `mesh`'s triangles, over the framed `keyframes`.
+pub fn measure_nodes(
+    mesh: &Mesh,
+    keyframes: &Keyframes,
+    nodes: &NodeOrders,
+    options: &MeasureOptions,
+    raster: &dyn RasterBackend,
+) -> Result<NodeMeasurement> {
+    let mut uses = vec![0u64; nodes.buffers.len()];
+    let mut overdraw = Vec::new();
+    if let Some(views) = options.views {
+        let cameras = views.cameras(keyframes.framing(), options.seed);
+        let mut per_view = vec![ViewCounts::default(); keyframes.len() * cameras.len()];
+        for (f, positions) in keyframes.frames.iter().enumerate() {
+            let mut by_buffer: Vec<Vec<usize>> = vec![Vec::new(); nodes.buffers.len()];
+            for (v, camera) in cameras.iter().enumerate() {
+                by_buffer[nodes.lookup.buffer(f, camera.eye)].push(v);
+            }
+            for (b, group) in by_buffer.iter().enumerate().filter(|(_, g)| !g.is_empty()) {
+                uses[b] += group.len() as u64;
+                let triangles = mesh.triangles_in_order(&nodes.buffers[b]);
+                let group_cameras: Vec<_> = group.iter().map(|&v| cameras[v]).collect();
+                let counts = raster.count(positions, &triangles, &group_cameras, options.res)?;
+                for (&v, c) in group.iter().zip(counts) {
+                    per_view[f * cameras.len() + v] = c;
+                }
+            }
+        }
+        let summary = |clip: Option<String>, frames: std::ops::Range<usize>| {
+            let per_view = per_view[frames.start * cameras.len()..frames.end * cameras.len()].to_vec();
+            let summary = OverdrawSummary::of(&per_view);
+            ClipOverdraw { clip, overdraw: Overdraw { views, res: options.res, per_view, summary } }
+        };
+        overdraw.push(summary(None, 0..keyframes.len()));
+        if keyframes.clips.len() > 1 {
+            overdraw.extend(keyframes.clips.iter().map(|(name, frames)| summary(Some(name.clone()), frames.clone())));
+        }
+    } else {
+        for &b in nodes.lookup.cells() {
+            uses[usize::from(b)] += 1;
+        }
+    }
+    let total = uses.iter().sum::<u64>() as f64;
+    let caches = options
+        .caches
+        .iter()
+        .map(|&model| {
+            let (mut acmr, mut atvr) = (0.0, 0.0);
+            for (buffer, &n) in nodes.buffers.iter().zip(&uses).filter(|(_, n)| **n > 0) {
+                let stats = cache::simulate(model, &mesh.triangles_in_order(buffer), mesh.vertex_count());
+                acmr += n as f64 * stats.acmr() / total;
+                atvr += n as f64 * stats.atvr() / total;
+            }
+            (model, acmr, atvr)
+        })
+        .collect();
+    Ok(NodeMeasurement { caches, overdraw })
+}
+
+/// One method's index buffers for an animation (or a static mesh as one frame), measured.
+#[derive(Debug, Clone)]
+pub struct NodeEvaluation {
+    pub method: String,
+    pub peer: bool,
+    /// Wall time of the ordering alone (posing the keyframes is loading, not ordering).
+    pub seconds: f64,
+    pub nodes: NodeOrders,
+    pub measurement: NodeMeasurement,
+}
+
+/// Orders `mesh` (the rest pose of `keyframes`) with `method` for every keyframe and view (timed)
+/// and measures the buffers.
+pub fn evaluate_nodes(
+    mesh: &Mesh,
+    topology: &Topology,
+    keyframes: &Keyframes,
+    method: &Resolved,
+    options: &MeasureOptions,
+    raster: &dyn RasterBackend,
+) -> Result<NodeEvaluation> {
+    let start = Instant::now();
+    let nodes = order::run_nodes(method, &OrderInput { mesh, topology }, keyframes)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let measurement = measure_nodes(mesh, keyframes, &nodes, options, raster)?;
+    Ok(NodeEvaluation { method: method.canonical(), peer: method.method.peer, seconds, nodes, measurement })
 }

@@ -47,6 +47,23 @@ struct Measure {
     backend: String,
 }
 
+/// Which animation to measure, for `eval` on a skinned glTF/GLB file.
+#[derive(Args, Clone, Default)]
+struct Animation {
+    /// Measure the animation, not the rest mesh: this clip, or `all`. Every keyframe is drawn
+    /// from every view of --views with the index buffer the method's lookup picks (Han & Sander
+    /// 2017, §4); static methods order the rest mesh and use that one buffer throughout.
+    #[arg(long, value_name = "NAME|all")]
+    clip: Option<String>,
+    /// Resample each clip to N evenly spaced frames instead of its keyframes (implies --clip all).
+    #[arg(long, value_name = "N")]
+    frames: Option<usize>,
+    /// Levels of Loop subdivision of the rest mesh, skinning weights and morphs included
+    /// (implies --clip all).
+    #[arg(long, value_name = "L")]
+    subdiv: Option<u32>,
+}
+
 /// The two halves of `bench`.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum BenchPart {
@@ -80,6 +97,10 @@ enum Command {
         common: Common,
     },
     /// Order a mesh with one or more methods and measure each order.
+    ///
+    /// With --clip (or --frames, --subdiv) the mesh is a skinned glTF/GLB animation; so it is
+    /// when the mesh is written PATH#clip=NAME,frames=N,subdiv=L. Keyframe- and view-dependent
+    /// methods (hs17, tipsify-per-frame) give several index buffers, counted in `buffers`.
     Eval {
         /// Mesh file or procedural spec.
         mesh: String,
@@ -88,6 +109,8 @@ enum Command {
         methods: Vec<String>,
         #[command(flatten)]
         measure: Measure,
+        #[command(flatten)]
+        animation: Animation,
         /// One JSON object per method per line instead of a table.
         #[arg(long)]
         json: bool,
@@ -145,8 +168,8 @@ fn main() -> ExitCode {
         Command::Order { input, output, method, remap_vertices, measure, common } => {
             commands::order(&input, &output, &method, remap_vertices, &measure, &common)
         }
-        Command::Eval { mesh, methods, measure, json, common } => {
-            commands::eval(&mesh, &methods, &measure, json, &common)
+        Command::Eval { mesh, methods, measure, animation, json, common } => {
+            commands::eval(&mesh, &methods, &measure, &animation, json, &common)
         }
         Command::Run { spec, quick, common } => commands::run(&spec, quick, &common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick),

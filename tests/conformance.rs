@@ -4,6 +4,7 @@
 
 mod common;
 
+use triorder::mesh::keyframes::Keyframes;
 use triorder::mesh::{Mesh, procedural};
 use triorder::order::{self, METHODS, OrderInput, ParamKind};
 use triorder::topology::Topology;
@@ -27,6 +28,10 @@ fn every_method_returns_a_permutation_with_winding_kept() {
         for mesh in &meshes {
             let topology = Topology::new(mesh);
             let input = OrderInput { mesh, topology: &topology };
+            if method.per_node {
+                check_node_orders(&resolved, &input);
+                continue;
+            }
             let order =
                 resolved.ordering.order(&input).unwrap_or_else(|e| panic!("{} on {}: {e}", method.name, mesh.name));
             order::check_permutation(&order, mesh.triangle_count())
@@ -41,6 +46,33 @@ fn every_method_returns_a_permutation_with_winding_kept() {
             assert_eq!(order, again, "{} on {} is not deterministic", method.name, mesh.name);
         }
     }
+}
+
+/// A keyframe- and view-dependent method on a static mesh (one frame): every buffer a
+/// permutation with winding kept, every lookup cell a buffer that exists, deterministic; and its
+/// single-order interface refuses by name rather than returning one buffer as if it were all.
+fn check_node_orders(resolved: &order::Resolved, input: &OrderInput) {
+    let (name, mesh) = (resolved.method.name, input.mesh);
+    let keyframes = Keyframes::still(mesh);
+    let nodes =
+        resolved.ordering.order_nodes(input, &keyframes).unwrap_or_else(|e| panic!("{name} on {}: {e}", mesh.name));
+    assert!(!nodes.buffers.is_empty());
+    for buffer in &nodes.buffers {
+        order::check_permutation(buffer, mesh.triangle_count())
+            .unwrap_or_else(|e| panic!("{name} on {}: {e}", mesh.name));
+    }
+    assert_eq!(nodes.lookup.frames(), 1);
+    assert!(nodes.lookup.cells().iter().all(|&b| usize::from(b) < nodes.buffers.len()), "{name} on {}", mesh.name);
+    order::run_nodes(resolved, input, &keyframes).unwrap();
+    let again = order::resolve(&resolved.canonical(), 7).unwrap().ordering.order_nodes(input, &keyframes).unwrap();
+    assert_eq!(
+        (&nodes.buffers, &nodes.lookup),
+        (&again.buffers, &again.lookup),
+        "{name} on {} is not deterministic",
+        mesh.name
+    );
+    let refused = resolved.ordering.order(input).err().unwrap_or_else(|| panic!("{name} gave one order"));
+    assert!(refused.to_string().contains(name), "{refused}");
 }
 
 #[test]

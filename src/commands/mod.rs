@@ -9,6 +9,8 @@ pub use experiments::{bench, plot, reproduce, run};
 use std::path::Path;
 
 use triorder::eval::{self, MeasureOptions};
+use triorder::mesh::keyframes::Keyframes;
+use triorder::mesh::source::AnimationSource;
 use triorder::mesh::{self, Mesh, report::MeshReport};
 use triorder::metrics::CacheModel;
 use triorder::order::{self, METHODS, params::describe_kind};
@@ -16,7 +18,7 @@ use triorder::raster::{self, RasterBackend, ViewSet};
 use triorder::topology::Topology;
 use triorder::{Error, Result};
 
-use crate::{Common, Measure};
+use crate::{Animation, Common, Measure};
 
 /// Parsed measurement options plus the chosen backend.
 struct Measuring {
@@ -60,11 +62,22 @@ pub fn methods() -> Result<()> {
     Ok(())
 }
 
-pub fn eval(source: &str, methods: &[String], measure: &Measure, json: bool, common: &Common) -> Result<()> {
+pub fn eval(
+    source: &str,
+    methods: &[String],
+    measure: &Measure,
+    animation: &Animation,
+    json: bool,
+    common: &Common,
+) -> Result<()> {
     let measuring = Measuring::new(measure, common.seed)?;
     let specs: Vec<&str> =
         if methods.is_empty() { vec!["input"] } else { methods.iter().map(String::as_str).collect() };
     let resolved = specs.iter().map(|s| order::resolve(s, common.seed)).collect::<Result<Vec<_>>>()?;
+    let animation = animation_source(source, animation)?;
+    if animation.is_some() || resolved.iter().any(|r| r.method.per_node) {
+        return eval_nodes(source, animation, &resolved, &measuring, json, common);
+    }
     let (mesh, topology) = open(source, common)?;
     let mut table = tables::EvalTable::new(&measuring.options);
     for method in &resolved {
@@ -73,6 +86,64 @@ pub fn eval(source: &str, methods: &[String], measure: &Measure, json: bool, com
             println!("{}", tables::eval_json(&mesh, &e, measuring.raster.name()));
         } else {
             table.push(&e);
+        }
+    }
+    if !json {
+        print!("{}", table.render(&mesh));
+    }
+    Ok(())
+}
+
+/// The animation `source` and the `--clip`/`--frames`/`--subdiv` options name, if any.
+fn animation_source(source: &str, options: &Animation) -> Result<Option<AnimationSource>> {
+    let given = options.clip.is_some() || options.frames.is_some() || options.subdiv.is_some();
+    if !given {
+        return AnimationSource::parse(source).transpose();
+    }
+    if source.contains('#') {
+        return Err(Error::usage(format!(
+            "`{source}` names its animation after `#`; drop --clip, --frames and --subdiv"
+        )));
+    }
+    let mut keys = vec![format!("clip={}", options.clip.as_deref().unwrap_or("all"))];
+    keys.extend(options.frames.map(|n| format!("frames={n}")));
+    keys.extend(options.subdiv.map(|l| format!("subdiv={l}")));
+    AnimationSource::parse(&format!("{source}#{}", keys.join(","))).transpose()
+}
+
+/// `eval` through index buffers per (keyframe, view): an animation, or a static mesh as one
+/// frame when a method is keyframe- or view-dependent.
+fn eval_nodes(
+    source: &str,
+    animation: Option<AnimationSource>,
+    methods: &[order::Resolved],
+    measuring: &Measuring,
+    json: bool,
+    common: &Common,
+) -> Result<()> {
+    let (mesh, topology, keyframes) = match animation {
+        Some(animation) => {
+            let data = mesh::source::data_dir(common.data.as_deref());
+            let (mesh, keyframes) = animation.open(data.as_deref())?;
+            let topology = Topology::new(&mesh);
+            let clips: Vec<String> = keyframes.clips.iter().map(|(n, r)| format!("{n} ({} frames)", r.len())).collect();
+            eprintln!("{source}: {}; clips: {}", MeshReport::new(&mesh, &topology), clips.join(", "));
+            (mesh, topology, keyframes)
+        }
+        None => {
+            let (mesh, topology) = open(source, common)?;
+            let keyframes = Keyframes::still(&mesh);
+            (mesh, topology, keyframes)
+        }
+    };
+    let mut table = tables::EvalTable::with_buffers(&measuring.options);
+    for method in methods {
+        let e =
+            eval::evaluate_nodes(&mesh, &topology, &keyframes, method, &measuring.options, measuring.raster.as_ref())?;
+        if json {
+            println!("{}", tables::nodes_json(&mesh, &keyframes, &e, measuring.raster.name()));
+        } else {
+            table.push_nodes(&e);
         }
     }
     if !json {

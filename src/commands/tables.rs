@@ -3,8 +3,10 @@
 use std::fmt::Write as _;
 
 use serde_json::{Map, Value, json};
-use triorder::eval::{Evaluation, MeasureOptions, Measurement};
+use triorder::eval::{Evaluation, MeasureOptions, Measurement, NodeEvaluation};
 use triorder::mesh::Mesh;
+use triorder::mesh::keyframes::Keyframes;
+use triorder::metrics::OverdrawSummary;
 
 /// `eval`'s readable table: one row per method, ACMR/ATVR per cache, OVR when measured.
 pub struct EvalTable {
@@ -22,14 +24,27 @@ impl EvalTable {
         EvalTable { header, rows: Vec::new() }
     }
 
+    /// The table for index buffers per (keyframe, view): a `buffers` column after the time.
+    pub fn with_buffers(options: &MeasureOptions) -> EvalTable {
+        let mut table = EvalTable::new(options);
+        table.header.insert(2, "buffers".into());
+        table
+    }
+
+    pub fn push_nodes(&mut self, e: &NodeEvaluation) {
+        let mut row = vec![e.method.clone(), format!("{:.4}", e.seconds), e.nodes.buffers.len().to_string()];
+        row.extend(e.measurement.caches.iter().map(|(_, acmr, atvr)| format!("{acmr:.4}/{atvr:.4}")));
+        if let Some(all) = e.measurement.overdraw.first() {
+            row.push(summary_cell(all.overdraw.summary));
+        }
+        self.rows.push(row);
+    }
+
     pub fn push(&mut self, e: &Evaluation) {
         let mut row = vec![e.method.clone(), format!("{:.4}", e.seconds)];
         row.extend(e.measurement.caches.iter().map(|(_, s)| format!("{:.4}/{:.4}", s.acmr(), s.atvr())));
         if let Some(o) = &e.measurement.overdraw {
-            row.push(match o.summary {
-                Some(s) => format!("{:.4}/{:.4}/{:.5}", s.mean, s.max, s.variance),
-                None => "no visible faces".into(),
-            });
+            row.push(summary_cell(o.summary));
         }
         self.rows.push(row);
     }
@@ -48,6 +63,13 @@ impl EvalTable {
     }
 }
 
+fn summary_cell(summary: Option<OverdrawSummary>) -> String {
+    match summary {
+        Some(s) => format!("{:.4}/{:.4}/{:.5}", s.mean, s.max, s.variance),
+        None => "no visible faces".into(),
+    }
+}
+
 /// One JSON object: the fields DESIGN.md promises (`method`, `triangles`, `vertices`, `cache`,
 /// `acmr`, `atvr` for the first cache, `seconds`, and with views `views`, `res`, `ovr_mean`,
 /// `ovr_max`), plus every cache under `caches` and the other overdraw statistics.
@@ -59,6 +81,7 @@ pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
     o.insert("triangles".into(), json!(mesh.triangle_count()));
     o.insert("vertices".into(), json!(mesh.vertex_count()));
     o.insert("seconds".into(), json!(e.seconds));
+    o.insert("buffers".into(), json!(1));
     if let Some((model, s)) = e.measurement.caches.first() {
         o.insert("cache".into(), json!(model.to_string()));
         o.insert("acmr".into(), json!(s.acmr()));
@@ -76,12 +99,66 @@ pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
         o.insert("res".into(), json!(od.res));
         o.insert("backend".into(), json!(backend));
         let s = od.summary;
-        o.insert("ovr_mean".into(), json!(s.map(|s| s.mean)));
-        o.insert("ovr_max".into(), json!(s.map(|s| s.max)));
-        o.insert("ovr_min".into(), json!(s.map(|s| s.min)));
-        o.insert("ovr_var".into(), json!(s.map(|s| s.variance)));
-        o.insert("ovr_ratio_of_sums".into(), json!(s.map(|s| s.ratio_of_sums)));
-        o.insert("empty_views".into(), json!(s.map_or(od.per_view.len(), |s| s.empty_views)));
+        insert_summary(&mut o, s, od.per_view.len());
+    }
+    Value::Object(o).to_string()
+}
+
+/// The overdraw statistics of one summary, under the names `eval --json` uses.
+fn insert_summary(o: &mut Map<String, Value>, s: Option<OverdrawSummary>, views: usize) {
+    o.insert("ovr_mean".into(), json!(s.map(|s| s.mean)));
+    o.insert("ovr_max".into(), json!(s.map(|s| s.max)));
+    o.insert("ovr_min".into(), json!(s.map(|s| s.min)));
+    o.insert("ovr_var".into(), json!(s.map(|s| s.variance)));
+    o.insert("ovr_ratio_of_sums".into(), json!(s.map(|s| s.ratio_of_sums)));
+    o.insert("empty_views".into(), json!(s.map_or(views, |s| s.empty_views)));
+}
+
+/// [`eval_json`]'s fields for index buffers per (keyframe, view): ACMR and ATVR averaged over
+/// the draws, OVR over every keyframe and view, plus `buffers` (index buffers the method needs),
+/// `keyframes`, the optimizer's `iterations`, `converged` and `phases` (seconds per phase) where
+/// it reports them, and `clips` with each clip's overdraw when there are several.
+pub fn nodes_json(mesh: &Mesh, keyframes: &Keyframes, e: &NodeEvaluation, backend: &str) -> String {
+    let mut o = Map::new();
+    o.insert("mesh".into(), json!(mesh.name));
+    o.insert("method".into(), json!(e.method));
+    o.insert("peer".into(), json!(e.peer));
+    o.insert("triangles".into(), json!(mesh.triangle_count()));
+    o.insert("vertices".into(), json!(mesh.vertex_count()));
+    o.insert("seconds".into(), json!(e.seconds));
+    o.insert("buffers".into(), json!(e.nodes.buffers.len()));
+    o.insert("keyframes".into(), json!(keyframes.len()));
+    o.insert("iterations".into(), json!(e.nodes.iterations));
+    o.insert("converged".into(), json!(e.nodes.converged));
+    let phases: Map<String, Value> = e.nodes.phases.iter().map(|(p, s)| (p.to_string(), json!(s))).collect();
+    o.insert("phases".into(), Value::Object(phases));
+    if let Some((model, acmr, atvr)) = e.measurement.caches.first() {
+        o.insert("cache".into(), json!(model.to_string()));
+        o.insert("acmr".into(), json!(acmr));
+        o.insert("atvr".into(), json!(atvr));
+    }
+    let caches: Vec<Value> = e
+        .measurement
+        .caches
+        .iter()
+        .map(|(m, acmr, atvr)| json!({"cache": m.to_string(), "acmr": acmr, "atvr": atvr}))
+        .collect();
+    o.insert("caches".into(), Value::Array(caches));
+    if let Some(all) = e.measurement.overdraw.first() {
+        o.insert("views".into(), json!(all.overdraw.views.to_string()));
+        o.insert("res".into(), json!(all.overdraw.res));
+        o.insert("backend".into(), json!(backend));
+        insert_summary(&mut o, all.overdraw.summary, all.overdraw.per_view.len());
+        let clips: Vec<Value> = e.measurement.overdraw[1..]
+            .iter()
+            .map(|c| {
+                let mut clip = Map::new();
+                clip.insert("clip".into(), json!(c.clip));
+                insert_summary(&mut clip, c.overdraw.summary, c.overdraw.per_view.len());
+                Value::Object(clip)
+            })
+            .collect();
+        o.insert("clips".into(), Value::Array(clips));
     }
     Value::Object(o).to_string()
 }

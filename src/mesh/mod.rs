@@ -9,6 +9,7 @@
 pub mod animated;
 pub mod gltf;
 pub mod gltf_animation;
+pub mod keyframes;
 pub mod load;
 pub mod obj;
 pub mod ply;

@@ -60,6 +60,7 @@ pub static METHOD: Method = Method {
     summary: "Forsyth: greedy by vertex scores (LRU position + valence boost), linear time",
     source: "Forsyth 2006, Linear-Speed Vertex Cache Optimisation",
     peer: false,
+    per_node: false,
     params: &[
         ParamInfo {
             name: "cache",

@@ -16,6 +16,7 @@ pub static METHOD: Method = Method {
     summary: "view-dependent: triangles sorted nearest first for one view direction",
     source: "Nehab, Barczak & Sander 2006, §1 and Fig. 1a (the depth-sorted reference)",
     peer: false,
+    per_node: false,
     params: &[
         ParamInfo { name: "x", default: "0", kind: COMPONENT, help: "view direction (model → eye), x" },
         ParamInfo { name: "y", default: "0", kind: COMPONENT, help: "view direction, y" },

@@ -32,6 +32,7 @@ pub static METHOD: Method = Method {
     summary: "Hilbert curve over grid squares (elsewhere: our Hilbert curve over triangle centroids)",
     source: "Bogomjakov & Gotsman 2002, §2.1, Fig. 2(b); gilbert for any grid size; non-grid generalisation ours",
     peer: false,
+    per_node: false,
     params: &[],
     build,
 };

@@ -64,6 +64,7 @@ pub static METHOD: Method = Method {
     summary: "greedy strip growing with FIFO look-ahead (Hoppe 1999)",
     source: "Hoppe 1999, greedy strip growing; author's MeshReorder meshify5",
     peer: false,
+    per_node: false,
     params: &[CACHE],
     build,
 };

@@ -9,6 +9,7 @@ pub static METHOD: Method = Method {
     summary: "the file's own triangle order (baseline)",
     source: "baseline in every paper",
     peer: false,
+    per_node: false,
     params: &[],
     build,
 };

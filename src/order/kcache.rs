@@ -61,6 +61,7 @@ pub static METHOD: Method = Method {
     summary: "K-Cache-Reorder: greedy focus vertex by simulated FIFO cost (Lin & Yu 2006)",
     source: "Lin & Yu 2006, IEEE TVCG 12(4), K-Cache-Reorder; Sander et al. 2007, Fig. 1",
     peer: false,
+    per_node: false,
     params: &[ParamInfo {
         name: "cache",
         default: "16",

@@ -11,6 +11,7 @@ pub static METHOD: Method = Method {
     summary: "meshoptimizer optimizeVertexCacheFifo (Tipsify) [peer]",
     source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §3",
     peer: true,
+    per_node: false,
     params: &[super::tipsify::FIFO_CACHE],
     build,
 };

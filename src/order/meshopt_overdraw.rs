@@ -12,6 +12,7 @@ pub static METHOD: Method = Method {
     summary: "meshoptimizer optimizeVertexCache + optimizeOverdraw (Sander 2007 clustering) [peer]",
     source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §4-5",
     peer: true,
+    per_node: false,
     params: &[ParamInfo {
         name: "threshold",
         default: "1.05",

@@ -11,6 +11,7 @@ pub static METHOD: Method = Method {
     summary: "meshoptimizer optimizeVertexCache (Forsyth-style) [peer]",
     source: "meshoptimizer via the meshopt crate; after Forsyth 2006",
     peer: true,
+    per_node: false,
     params: &[],
     build,
 };

@@ -55,6 +55,7 @@ pub static METHOD: Method = Method {
     summary: "minimum linear arrangement of the dual graph (multilevel: contraction, relaxation, windows)",
     source: "Bogomjakov & Gotsman 2002, §2.3; solver after Safro, Ron & Brandt 2006",
     peer: false,
+    per_node: false,
     params: &[],
     build,
 };

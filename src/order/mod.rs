@@ -14,6 +14,7 @@ mod front_to_back;
 mod grid_walk;
 mod hilbert;
 mod hoppe;
+mod hs17;
 mod input;
 mod kcache;
 mod meshopt_fifo;
@@ -22,6 +23,7 @@ mod meshopt_vcache;
 mod mla;
 mod nehab;
 pub mod overdraw_graph;
+pub mod per_node;
 pub(crate) mod planar_clusters;
 mod random;
 mod recursive_cut;
@@ -29,11 +31,14 @@ pub(crate) mod sander07;
 mod snake;
 mod strips;
 pub(crate) mod tipsify;
+mod tipsify_per_frame;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::mesh::keyframes::Keyframes;
 use crate::topology::Topology;
 pub use params::{MethodSpec, ParamInfo, ParamKind, Params};
+pub use per_node::{Lookup, NodeOrders};
 
 /// A draw order: position `i` holds the id of the triangle drawn `i`-th. Always a permutation of
 /// `0..triangle_count`; triangles keep their vertex order (and so their winding).
@@ -54,6 +59,14 @@ pub trait Ordering: Send + Sync {
     /// another (figures colour them); any other method is one cluster.
     fn clustered(&self, input: &OrderInput) -> Result<Clustered> {
         Ok(Clustered::single(self.order(input)?))
+    }
+
+    /// The index buffers for drawing `keyframes` (framed poses of `input.mesh`'s connectivity)
+    /// and the table that picks one per keyframe and view direction. A static method orders the
+    /// rest mesh `input.mesh` once and uses that one buffer everywhere, as an engine would ship
+    /// it; keyframe- and view-dependent methods (those registered with `per_node`) override this.
+    fn order_nodes(&self, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
+        Ok(NodeOrders::single(self.order(input)?, keyframes.len()))
     }
 }
 
@@ -95,6 +108,9 @@ pub struct Method {
     pub source: &'static str,
     /// True for methods that call another library (the `meshopt` crate) rather than our own code.
     pub peer: bool,
+    /// True for methods whose output is several index buffers chosen per keyframe and view
+    /// ([`Ordering::order_nodes`]); their single-order [`Ordering::order`] is an error.
+    pub per_node: bool,
     pub params: &'static [ParamInfo],
     pub build: fn(&Params) -> Box<dyn Ordering>,
 }
@@ -118,6 +134,8 @@ pub static METHODS: &[&Method] = &[
     &meshopt_overdraw::METHOD,
     &nehab::METHOD,
     &front_to_back::METHOD,
+    &tipsify_per_frame::METHOD,
+    &hs17::METHOD,
 ];
 
 /// A method spec resolved against the registry: ready to run, with its canonical name.
@@ -173,6 +191,39 @@ pub fn run_clustered(resolved: &Resolved, input: &OrderInput) -> Result<Clustere
             Error::usage(format!("internal error: `{}` returned an invalid order: {why}", resolved.canonical()))
         })?;
     Ok(clustered)
+}
+
+/// [`run`] for every method and any animation: checks that each buffer is a permutation and that
+/// the lookup covers every keyframe with a buffer that exists.
+pub fn run_nodes(resolved: &Resolved, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
+    let nodes = resolved.ordering.order_nodes(input, keyframes)?;
+    let n = input.mesh.triangle_count();
+    let checked = nodes
+        .buffers
+        .iter()
+        .enumerate()
+        .try_for_each(|(i, b)| check_permutation(b, n).map_err(|why| format!("buffer {i}: {why}")))
+        .and_then(|()| {
+            if nodes.lookup.frames() != keyframes.len() {
+                Err(format!("its lookup has {} frames for {} keyframes", nodes.lookup.frames(), keyframes.len()))
+            } else if nodes.lookup.cells().iter().any(|&b| usize::from(b) >= nodes.buffers.len()) {
+                Err(format!("its lookup names a buffer beyond its {}", nodes.buffers.len()))
+            } else {
+                Ok(())
+            }
+        });
+    checked.map_err(|why| {
+        Error::usage(format!("internal error: `{}` returned invalid index buffers: {why}", resolved.canonical()))
+    })?;
+    Ok(nodes)
+}
+
+/// The error a per-node method gives when asked for one order.
+pub(crate) fn needs_nodes(method: &str) -> Error {
+    Error::usage(format!(
+        "method `{method}` draws with several index buffers chosen per keyframe and view, not one order: \
+         measure it with `triorder eval` (add --views; for an animation, --clip), or in an experiment"
+    ))
 }
 
 /// True when cluster `starts` cut an order of `n` triangles into consecutive runs: from 0 to `n`,

@@ -31,6 +31,7 @@ pub static METHOD: Method = Method {
     summary: "planar clusters ordered by a view-independent overdraw graph (greedy FAS), locality inside",
     source: "Nehab, Barczak & Sander 2006, §3-5",
     peer: false,
+    per_node: false,
     params: &[
         ParamInfo {
             name: "clusters",

@@ -13,6 +13,7 @@ pub static METHOD: Method = Method {
     summary: "uniformly random permutation (worst-case reference)",
     source: "Bogomjakov & Gotsman 2002, Fig. 5; Nehab et al. 2006, Fig. 7-8",
     peer: false,
+    per_node: false,
     params: &[ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "random seed" }],
     build,
 };

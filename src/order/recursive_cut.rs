@@ -54,6 +54,7 @@ pub static METHOD: Method = Method {
     summary: "recursive METIS bisection of the dual graph with gate edges (universal sequence)",
     source: "Bogomjakov & Gotsman 2002, §2.1-2.2, Fig. 3",
     peer: false,
+    per_node: false,
     params: &[ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "METIS random seed" }],
     build,
 };

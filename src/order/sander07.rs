@@ -31,6 +31,7 @@ pub static METHOD: Method = Method {
     summary: "Tipsify + fast linear clustering (λ) + dot-rule cluster sort, no rendering",
     source: "Sander, Nehab & Barczak 2007, §3-5",
     peer: false,
+    per_node: false,
     params: &[FIFO_CACHE, LAMBDA],
     build,
 };
@@ -64,11 +65,19 @@ impl Ordering for Sander07 {
 
 /// The whole pipeline on `mesh`, whose vertex→triangle adjacency is `vertex_triangles`.
 pub(crate) fn sander07(mesh: &Mesh, vertex_triangles: &Csr, cache: u32, lambda: f64) -> Clustered {
-    let (order, dead_ends) = tipsify(&mesh.triangles, vertex_triangles, cache);
-    let starts = linear_clusters(&mesh.triangles, &order, &dead_ends, mesh.vertex_count(), cache, lambda);
-    let clusters: Vec<&[u32]> = starts.windows(2).map(|w| &order[w[0]..w[1]]).collect();
+    let patches = patches(mesh, vertex_triangles, cache, lambda);
+    let clusters: Vec<&[u32]> = patches.starts.windows(2).map(|w| &patches.order[w[0]..w[1]]).collect();
     let sorted = dot_rule_sort(&mesh.positions, &mesh.triangles, &clusters);
     Clustered::concat(sorted.iter().map(|&c| clusters[c]))
+}
+
+/// The first two stages, which use connectivity only: the Tipsify order cut into clusters by
+/// fast linear clustering with `lambda`, in Tipsify's order. The animated orderings (Han &
+/// Sander 2017, §3.1) start from these "cache-efficient patches" and only reorder them.
+pub(crate) fn patches(mesh: &Mesh, vertex_triangles: &Csr, cache: u32, lambda: f64) -> Clustered {
+    let (order, dead_ends) = tipsify(&mesh.triangles, vertex_triangles, cache);
+    let starts = linear_clusters(&mesh.triangles, &order, &dead_ends, mesh.vertex_count(), cache, lambda);
+    Clustered { order, starts }
 }
 
 /// Cluster starts (ending with `order.len()`) of the fast linear clustering of `order`, a Tipsify

@@ -27,6 +27,7 @@ pub static METHOD: Method = Method {
     summary: "boustrophedon rows of grid squares (elsewhere: our 3D boustrophedon over triangle centroids)",
     source: "Bogomjakov & Gotsman 2002, §2.1, Fig. 2(a); non-grid generalisation ours",
     peer: false,
+    per_node: false,
     params: &[],
     build,
 };

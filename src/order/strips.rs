@@ -29,6 +29,7 @@ pub static METHOD: Method = Method {
     summary: "meshoptimizer strip order + stripify, drawn as the strip's triangles (B&G Table 2 strips) [peer]",
     source: "meshoptimizer via the meshopt crate (after Evans et al. 1996); Bogomjakov & Gotsman 2002, Table 2",
     peer: true,
+    per_node: false,
     params: &[],
     build,
 };

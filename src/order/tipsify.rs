@@ -23,6 +23,7 @@ pub static METHOD: Method = Method {
     summary: "Tipsify: vertex fans steered by a FIFO cache model, O(F)",
     source: "Sander, Nehab & Barczak 2007, §3 (Tipsify)",
     peer: false,
+    per_node: false,
     params: &[FIFO_CACHE],
     build,
 };

@@ -1,0 +1,424 @@
+//! `hs17`: Han & Sander 2017, "Triangle Reordering for Efficient Rendering in Complex Scenes"
+//! (JCGT 6(3)), §3 and Algorithm 1, our own implementation: k index buffers for an animated mesh
+//! and the lookup table that picks one per keyframe and view.
+//!
+//! 1. **Patches** (§3.1): Tipsify, cut by fast linear clustering with λ (`sander07`'s first two
+//!    stages); every buffer is an order of these patches, so each keeps their ACMR.
+//! 2. **Nodes** (§3.2): one per (keyframe, viewpoint), the viewpoints being the `views`
+//!    icosahedron directions at 3× the animation's radius, seen with a perspective camera (the
+//!    same camera `random:N` evaluation views use), each frame framed at its own centre.
+//! 3. **Bootstrapping**: `clusters` viewpoints drawn at random (seeded), a draw rejected while it
+//!    lies within [`MIN_SEPARATION`] of one already drawn ("we ensure no two initial viewpoints are
+//!    within a small distance threshold"); each starts a buffer that sorts the patches front to
+//!    back by the distance from the viewpoint to the patch centroid averaged over all frames.
+//! 4. **Node assignment** (step 1): each node goes to the buffer that draws it with the fewest
+//!    fragments passing the depth test. The paper renders the node with each buffer and reads an
+//!    occlusion query; we rasterize the node once with our CPU rasterizer (same rules as every
+//!    overdraw measurement here), keep its fragments, and replay the depth test in each buffer's
+//!    order, which gives exactly the counts of k renders for the price of one. A node whose
+//!    buffer ties for the fewest keeps it, so ties cannot make the loop cycle.
+//! 5. **Buffer computation** (step 2): for each cluster, patches sorted by increasing integrated
+//!    distance d(p) = Σ over its nodes of |viewpoint − centroid of p at the node's frame|.
+//! 6. Steps 1–2 repeat until no node changes cluster, or `iterations` rounds (reported).
+//!
+//! `mode=single` optimizes each clip on its own (k buffers per clip, the paper's "single");
+//! `mode=joint` one set of k buffers for all frames of all clips. Buffers that end with no node
+//! are dropped, so the buffer count is what the lookup can pick. A static mesh is an animation
+//! of one frame, and the result is then k view-dependent buffers.
+
+use std::ops::Range;
+use std::time::Instant;
+
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
+
+use super::per_node::{Lookup, NodeOrders};
+use super::sander07::{LAMBDA, patches};
+use super::tipsify::FIFO_CACHE;
+use super::{Clustered, Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params, needs_nodes};
+use crate::error::{Error, Result};
+use crate::mesh::keyframes::Keyframes;
+use crate::raster::cpu::{Fragment, fragments};
+use crate::raster::views::{Camera, icosphere_directions, perspective};
+
+pub static METHOD: Method = Method {
+    name: "hs17",
+    summary: "animated: Tipsify patches ordered by k-means over (keyframe, viewpoint) nodes; k buffers + lookup",
+    source: "Han & Sander 2017, §3 and Algorithm 1",
+    peer: false,
+    per_node: true,
+    params: &[
+        ParamInfo {
+            name: "clusters",
+            default: "5",
+            kind: ParamKind::Int { min: 1, max: 64 },
+            help: "k, the number of index buffers (per clip with mode=single)",
+        },
+        LAMBDA,
+        ParamInfo {
+            name: "views",
+            default: "162",
+            kind: ParamKind::Choice(&["12", "42", "162", "642"]),
+            help: "icosahedron viewpoints optimized for (nodes = keyframes × views)",
+        },
+        ParamInfo {
+            name: "res",
+            default: "128",
+            kind: ParamKind::Int { min: 16, max: 4096 },
+            help: "side of the square images nodes are rasterized at during optimization",
+        },
+        ParamInfo {
+            name: "mode",
+            default: "single",
+            kind: ParamKind::Choice(&["single", "joint"]),
+            help: "single: k buffers for each clip; joint: k buffers shared by all clips",
+        },
+        ParamInfo {
+            name: "iterations",
+            default: "50",
+            kind: ParamKind::Int { min: 1, max: 1000 },
+            help: "most node-assignment rounds before stopping unconverged (reported)",
+        },
+        FIFO_CACHE,
+        ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "picks the initial viewpoints" },
+    ],
+    build,
+};
+
+/// Smallest angle (radians) between two initial viewpoints: 30°. With the rejection capped at
+/// [`SEPARATION_TRIES`] draws, a k too large to spread that far still gets k distinct viewpoints.
+const MIN_SEPARATION: f32 = std::f32::consts::PI / 6.0;
+const SEPARATION_TRIES: usize = 100;
+
+fn build(params: &Params) -> Box<dyn Ordering> {
+    Box::new(Hs17 {
+        clusters: params.int("clusters") as usize,
+        lambda: params.float("lambda"),
+        views: params.word("views").parse().expect("the schema lists only numbers"),
+        res: params.int("res") as u32,
+        joint: params.word("mode") == "joint",
+        max_iterations: params.int("iterations") as usize,
+        cache: params.int("cache") as u32,
+        seed: params.seed(),
+    })
+}
+
+struct Hs17 {
+    clusters: usize,
+    lambda: f64,
+    views: u32,
+    res: u32,
+    joint: bool,
+    max_iterations: usize,
+    cache: u32,
+    seed: u64,
+}
+
+impl Ordering for Hs17 {
+    fn order(&self, _: &OrderInput) -> Result<Order> {
+        Err(needs_nodes(METHOD.name))
+    }
+
+    fn order_nodes(&self, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
+        let mut clock = Clock::start();
+        let patches = patches(input.mesh, &input.topology.vertex_triangles, self.cache, self.lambda);
+        clock.lap("patches");
+        let directions = icosphere_directions(self.views);
+        let cameras: Vec<Camera> = directions.iter().map(|&d| perspective(keyframes.framing(), d)).collect();
+        let scene = Scene { triangles: &input.mesh.triangles, keyframes, patches: &patches, cameras: &cameras };
+        let groups: Vec<Range<usize>> = if self.joint {
+            std::iter::once(0..keyframes.len()).collect()
+        } else {
+            keyframes.clips.iter().map(|(_, r)| r.clone()).collect()
+        };
+
+        let mut buffers: Vec<Order> = Vec::new();
+        let mut assignment = vec![0u16; keyframes.len() * cameras.len()];
+        let (mut iterations, mut converged) = (0, true);
+        for frames in groups {
+            let result = self.kmeans(&scene, frames.clone(), &mut clock)?;
+            iterations = iterations.max(result.iterations);
+            converged &= result.converged;
+            // Keep the buffers some node uses, numbered after the previous groups' buffers.
+            let mut id = vec![u16::MAX; result.buffers.len()];
+            for &c in &result.assignment {
+                if id[c as usize] == u16::MAX {
+                    id[c as usize] = u16::try_from(buffers.len())
+                        .map_err(|_| Error::usage("hs17: more than 65535 index buffers".to_string()))?;
+                    buffers.push(result.buffers[c as usize].clone());
+                }
+            }
+            let start = frames.start * cameras.len();
+            for (slot, &c) in assignment[start..].iter_mut().zip(&result.assignment) {
+                *slot = id[c as usize];
+            }
+        }
+        let lookup = Lookup::nearest(&directions, &assignment);
+        Ok(NodeOrders { buffers, lookup, iterations: Some(iterations), converged, phases: clock.phases })
+    }
+}
+
+/// What every k-means run shares.
+struct Scene<'a> {
+    triangles: &'a [[u32; 3]],
+    keyframes: &'a Keyframes,
+    patches: &'a Clustered,
+    cameras: &'a [Camera],
+}
+
+impl Scene<'_> {
+    fn patch_count(&self) -> usize {
+        self.patches.cluster_count()
+    }
+
+    /// The buffer drawing the patches in `sequence`.
+    fn buffer(&self, sequence: &[usize]) -> Order {
+        let starts = &self.patches.starts;
+        sequence.iter().flat_map(|&p| &self.patches.order[starts[p]..starts[p + 1]]).copied().collect()
+    }
+}
+
+/// One k-means over the nodes of a run of frames.
+struct KMeans {
+    buffers: Vec<Order>,
+    /// Per node `(frame − first) × views + view`: its cluster.
+    assignment: Vec<u16>,
+    iterations: usize,
+    converged: bool,
+}
+
+impl Hs17 {
+    fn kmeans(&self, scene: &Scene, frames: Range<usize>, clock: &mut Clock) -> Result<KMeans> {
+        let views = scene.cameras.len();
+        // Patch centroids, patch-major: centroids[p * frames + f].
+        let centroids = patch_centroids(scene, frames.clone());
+        let frame_count = frames.len();
+        let average: Vec<Vec3> =
+            centroids.chunks(frame_count).map(|c| c.iter().sum::<Vec3>() / c.len() as f32).collect();
+        clock.lap("centroids");
+
+        let mut buffers: Vec<Order> = self
+            .initial_viewpoints(views, scene.cameras)
+            .iter()
+            .map(|&v| scene.buffer(&sort_by_key(&average, |c| c.distance(scene.cameras[v].eye))))
+            .collect();
+        let nodes = rasterize_nodes(scene, frames.clone(), self.res)?;
+        clock.lap("rasterization");
+        let mut assignment: Vec<u16> = vec![u16::MAX; nodes.len()];
+        let mut iteration = 0;
+        loop {
+            iteration += 1;
+            let next = assign(&nodes, &buffers, &assignment, scene.triangles.len());
+            clock.lap("assignment");
+            let converged = next == assignment;
+            assignment = next;
+            // Stopping right after an assignment keeps the lookup true to the buffers returned.
+            if converged || iteration == self.max_iterations {
+                return Ok(KMeans { buffers, assignment, iterations: iteration, converged });
+            }
+            for (c, buffer) in buffers.iter_mut().enumerate() {
+                let members: Vec<usize> = (0..nodes.len()).filter(|&n| usize::from(assignment[n]) == c).collect();
+                if members.is_empty() {
+                    continue;
+                }
+                let d: Vec<f32> = (0..scene.patch_count())
+                    .into_par_iter()
+                    .map(|p| {
+                        let at = &centroids[p * frame_count..(p + 1) * frame_count];
+                        members.iter().map(|&n| scene.cameras[n % views].eye.distance(at[n / views])).sum()
+                    })
+                    .collect();
+                *buffer = scene.buffer(&sort_by_key(&d, |&d| d));
+            }
+            clock.lap("buffers");
+        }
+    }
+
+    /// `clusters` distinct viewpoint indices, drawn with the separation rule.
+    fn initial_viewpoints(&self, views: usize, cameras: &[Camera]) -> Vec<usize> {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(self.seed);
+        let k = self.clusters.min(views);
+        let mut chosen: Vec<usize> = Vec::with_capacity(k);
+        let direction = |v: usize| cameras[v].eye.normalize();
+        while chosen.len() < k {
+            let mut pick = rng.random_range(0..views);
+            for _ in 0..SEPARATION_TRIES {
+                let far = chosen.iter().all(|&c| direction(c).angle_between(direction(pick)) >= MIN_SEPARATION);
+                if far && !chosen.contains(&pick) {
+                    break;
+                }
+                pick = rng.random_range(0..views);
+            }
+            if !chosen.contains(&pick) {
+                chosen.push(pick);
+            }
+        }
+        chosen
+    }
+}
+
+/// Indices `0..keys.len()` sorted by increasing `key`, ties by index.
+fn sort_by_key<T>(keys: &[T], key: impl Fn(&T) -> f32) -> Vec<usize> {
+    let values: Vec<f32> = keys.iter().map(key).collect();
+    let mut sorted: Vec<usize> = (0..keys.len()).collect();
+    sorted.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
+    sorted
+}
+
+/// Per patch, per frame of `frames`: the mean of its triangles' corners.
+fn patch_centroids(scene: &Scene, frames: Range<usize>) -> Vec<Vec3> {
+    let starts = &scene.patches.starts;
+    (0..scene.patch_count())
+        .into_par_iter()
+        .flat_map_iter(|p| {
+            let tris = &scene.patches.order[starts[p]..starts[p + 1]];
+            let corners = 3.0 * tris.len() as f32;
+            frames.clone().map(move |f| {
+                let positions = &scene.keyframes.frames[f];
+                tris.iter().flat_map(|&t| scene.triangles[t as usize]).map(|v| positions[v as usize]).sum::<Vec3>()
+                    / corners
+            })
+        })
+        .collect()
+}
+
+/// Every node of `frames` rasterized once: node `(f − first) × views + v` is frame f seen by
+/// camera v. The depth test of any buffer is then replayed from these ([`Contested::passed`]).
+fn rasterize_nodes(scene: &Scene, frames: Range<usize>, res: u32) -> Result<Vec<Contested>> {
+    let views = scene.cameras.len();
+    (0..frames.len() * views)
+        .into_par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(fragments_, slots), n| {
+                let (frame, camera) = (frames.start + n / views, &scene.cameras[n % views]);
+                fragments(&scene.keyframes.frames[frame], scene.triangles, camera, res, fragments_)?;
+                Ok(Contested::of(fragments_, res, slots))
+            },
+        )
+        .collect()
+}
+
+/// Step 1: each node to the buffer with the fewest passing fragments; a node keeps its
+/// `previous` buffer when that one ties for the fewest.
+fn assign(nodes: &[Contested], buffers: &[Order], previous: &[u16], triangles: usize) -> Vec<u16> {
+    let ranks: Vec<Vec<u32>> = buffers
+        .par_iter()
+        .map(|b| {
+            let mut rank = vec![0; triangles];
+            for (i, &t) in b.iter().enumerate() {
+                rank[t as usize] = i as u32;
+            }
+            rank
+        })
+        .collect();
+    nodes
+        .par_iter()
+        .zip(previous)
+        .map(|(node, &before)| {
+            let passed: Vec<u32> = ranks.iter().map(|rank| node.passed(rank)).collect();
+            let best = *passed.iter().min().expect("at least one buffer");
+            let keep = passed.get(usize::from(before)).is_some_and(|&p| p == best);
+            if keep { before } else { passed.iter().position(|&p| p == best).unwrap() as u16 }
+        })
+        .collect()
+}
+
+/// What of one node's rasterization depends on the draw order: the pixels reached by two or
+/// more fragments, each with its triangles nearest first. A pixel with one fragment passes it
+/// in every order, so it cannot favour one buffer and is left out.
+struct Contested {
+    /// Per contested pixel, its triangles by increasing depth; [`TIED`] marks a triangle at the
+    /// same depth as the one before it.
+    triangles: Vec<u32>,
+    /// Pixel `i`'s entries are `triangles[starts[i]..starts[i + 1]]`.
+    starts: Vec<u32>,
+}
+
+/// Flags a triangle id in [`Contested::triangles`] (ids stay below 2³¹: meshes are far smaller).
+const TIED: u32 = 1 << 31;
+
+impl Contested {
+    /// Groups `fragments` by pixel (a counting sort over the image, scratch in `slots`) and keeps
+    /// the contested pixels, each sorted by depth.
+    fn of(fragments: &[Fragment], res: u32, slots: &mut Vec<u32>) -> Contested {
+        let pixels = res as usize * res as usize;
+        slots.clear();
+        slots.resize(pixels + 1, 0);
+        for f in fragments {
+            slots[f.pixel as usize + 1] += 1;
+        }
+        for p in 0..pixels {
+            slots[p + 1] += slots[p];
+        }
+        let mut by_pixel = vec![(0.0f32, 0u32); fragments.len()];
+        let mut next = slots[..pixels].to_vec();
+        for f in fragments {
+            let slot = &mut next[f.pixel as usize];
+            by_pixel[*slot as usize] = (f.depth, f.triangle);
+            *slot += 1;
+        }
+        let (mut triangles, mut starts) = (Vec::new(), vec![0]);
+        for p in 0..pixels {
+            let entries = &mut by_pixel[slots[p] as usize..slots[p + 1] as usize];
+            if entries.len() < 2 {
+                continue;
+            }
+            entries.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (i, &(depth, t)) in entries.iter().enumerate() {
+                let tied = i > 0 && entries[i - 1].0 == depth;
+                triangles.push(if tied { t | TIED } else { t });
+            }
+            starts.push(triangles.len() as u32);
+        }
+        Contested { triangles, starts }
+    }
+
+    /// Fragments passing a LESS depth test, over the contested pixels, when triangle t is drawn
+    /// `rank[t]`-th. A fragment passes when it is drawn before every nearer one; of fragments at
+    /// one depth only the first drawn can pass.
+    fn passed(&self, rank: &[u32]) -> u32 {
+        let mut passed = 0;
+        for w in self.starts.windows(2) {
+            let entries = &self.triangles[w[0] as usize..w[1] as usize];
+            // The earliest draw among strictly nearer fragments, and among those at this depth.
+            let (mut nearer, mut group) = (u32::MAX, u32::MAX);
+            for &entry in entries {
+                let r = rank[(entry & !TIED) as usize];
+                if entry & TIED == 0 {
+                    passed += u32::from(group < nearer);
+                    nearer = nearer.min(group);
+                    group = r;
+                } else {
+                    group = group.min(r);
+                }
+            }
+            passed += u32::from(group < nearer);
+        }
+        passed
+    }
+}
+
+/// Wall time per phase, summed over laps.
+struct Clock {
+    phases: Vec<(&'static str, f64)>,
+    last: Instant,
+}
+
+impl Clock {
+    fn start() -> Clock {
+        Clock { phases: Vec::new(), last: Instant::now() }
+    }
+
+    /// Charges the time since the previous lap to `phase`.
+    fn lap(&mut self, phase: &'static str) {
+        let now = Instant::now();
+        let seconds = now.duration_since(self.last).as_secs_f64();
+        self.last = now;
+        match self.phases.iter_mut().find(|(p, _)| *p == phase) {
+            Some((_, s)) => *s += seconds,
+            None => self.phases.push((phase, seconds)),
+        }
+    }
+}
