@@ -229,3 +229,85 @@ fn failed_orders_leave_no_output() {
     assert!(fails(&["order", "grid:4x4", "-o", dir.path().to_str().unwrap()]).contains("directory"));
     assert_eq!(listing(), 0);
 }
+
+/// The shared animated model `name` as a path argument, or `None` (the test passes) without the
+/// data directory.
+fn animated_model(name: &str) -> Option<String> {
+    Some(common::data_dir()?.join("animated").join(name).to_string_lossy().into_owned())
+}
+
+/// Animation options and `#` sources with a bad value fail before any file is read, naming the
+/// source and the value; a static file asked for an animation says it is not glTF.
+#[test]
+fn bad_animation_options_are_named() {
+    let max = triorder::mesh::source::MAX_SUBDIVISION;
+    let err = fails(&["eval", "walker.glb", "--frames", "0", "-m", "hs17"]);
+    assert!(err.contains("walker.glb") && err.contains("frames `0`"), "{err}");
+    let err = fails(&["eval", "walker.glb", "--subdiv", "9", "-m", "hs17"]);
+    assert!(err.contains("walker.glb") && err.contains("subdiv `9`") && err.contains(&format!("0..={max}")), "{err}");
+    let err = fails(&["eval", "walker.glb#clip=Walk,speed=2", "-m", "hs17"]);
+    assert!(err.contains("walker.glb#clip=Walk,speed=2") && err.contains("unknown key `speed`"), "{err}");
+    let err = fails(&["eval", "walker.glb#clip=Walk", "--clip", "Run"]);
+    assert!(err.contains("walker.glb#clip=Walk") && err.contains("--clip"), "{err}");
+    let err = fails(&["eval", "assets/spot.obj", "--clip", "all", "-m", "hs17"]);
+    assert!(err.contains("assets/spot.obj") && err.contains("not a .glb or .gltf file"), "{err}");
+}
+
+#[test]
+fn unknown_clip_lists_the_clips() {
+    let Some(fox) = animated_model("Fox.glb") else { return };
+    let clips = triorder::mesh::gltf_animation::read_animated(Path::new(&fox), &Default::default()).unwrap().clips;
+    let err = fails(&["eval", &fox, "--clip", "Dance", "-m", "hs17:views=12,res=32", "--views", "random:4"]);
+    assert!(err.contains(&fox) && err.contains("'Dance'"), "{err}");
+    for clip in &clips {
+        assert!(err.contains(&clip.name), "{err} does not list {}", clip.name);
+    }
+}
+
+/// `order` writes one order: keyframe- and view-dependent methods are refused before the mesh is
+/// even opened (so a missing file is not what is reported), and nothing is written.
+#[test]
+fn order_refuses_per_node_methods() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    for method in ["hs17", "hs17:clusters=2", "tipsify-per-frame"] {
+        let err = fails(&["order", "no/such/file.ply", "-o", out.to_str().unwrap(), "-m", method]);
+        let name = method.split(':').next().unwrap();
+        assert!(err.contains(&format!("method `{name}`")) && err.contains("triorder eval"), "{err}");
+        assert!(!err.contains("no/such/file.ply"), "{method}: the file was opened first: {err}");
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// `eval --clip` through hs17 and tipsify-per-frame: one JSON line per method with the buffer
+/// count, the keyframes, the k-means report and the overdraw per clip.
+#[test]
+fn eval_animation_json_reports_buffers_and_keyframes() {
+    let Some(fox) = animated_model("Fox.glb") else { return };
+    let frames = 2;
+    let selection = triorder::mesh::gltf_animation::ClipSelection { clip: None, frames: Some(frames) };
+    let animated = triorder::mesh::gltf_animation::read_animated(Path::new(&fox), &selection).unwrap();
+    let keyframes: usize = animated.clips.iter().map(|c| c.frames.len()).sum();
+    let clusters = 2;
+    let hs17 = format!("hs17:views=12,res=32,clusters={clusters}");
+    let args = ["eval", &fox, "--clip", "all", "--frames", "2", "-m", &hs17, "-m", "tipsify-per-frame"];
+    let o = triorder(&[&args[..], &["--views", "random:20", "--res", "32", "--json"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines: Vec<serde_json::Value> = stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 2, "{}", stdout(&o));
+    for line in &lines {
+        assert_eq!(line["keyframes"], keyframes, "{line}");
+        assert_eq!(line["triangles"], animated.mesh.triangle_count(), "{line}");
+        assert_eq!(line["views"], "random:20");
+        assert!(line["ovr_mean"].as_f64().unwrap() >= 1.0, "{line}");
+        let clips: Vec<&str> = line["clips"].as_array().unwrap().iter().map(|c| c["clip"].as_str().unwrap()).collect();
+        assert_eq!(clips, animated.clips.iter().map(|c| c.name.as_str()).collect::<Vec<_>>());
+    }
+    let (hs17, per_frame) = (&lines[0], &lines[1]);
+    let buffers = hs17["buffers"].as_u64().unwrap() as usize;
+    // mode=single: at most k buffers for each clip.
+    assert!((1..=clusters * animated.clips.len()).contains(&buffers), "{hs17}");
+    assert!(hs17["iterations"].as_u64().unwrap() >= 1 && hs17["converged"].is_boolean(), "{hs17}");
+    assert!(hs17["phases"].as_object().unwrap().contains_key("rasterization"), "{hs17}");
+    assert_eq!(per_frame["buffers"], keyframes, "one buffer per keyframe");
+}

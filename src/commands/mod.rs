@@ -162,6 +162,15 @@ pub fn order(
 ) -> Result<()> {
     let measuring = Measuring::new(measure, common.seed)?;
     let resolved = order::resolve(method, common.seed)?;
+    if resolved.method.per_node {
+        return Err(order::needs_nodes(resolved.method.name));
+    }
+    if AnimationSource::parse(source).is_some() {
+        return Err(Error::usage(format!(
+            "`{source}`: `order` writes a static mesh and would drop the animation; \
+             name the file without `#...` to reorder its rest mesh"
+        )));
+    }
     if output.is_dir() {
         return Err(Error::output(output, "is a directory"));
     }

@@ -91,8 +91,16 @@ pub fn read_with_rest_pose(path: &Path, selection: &ClipSelection) -> Result<(An
     if selection.frames == Some(0) {
         return Err(Error::usage("a clip resampled to 0 frames has nothing to pose; ask for at least 1"));
     }
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !matches!(extension.as_deref(), Some("glb" | "gltf")) {
+        return Err(fail(
+            "is not a .glb or .gltf file: only glTF holds animations (--clip, --frames, --subdiv or `#...`); \
+             name it without them to load it as a static mesh"
+                .to_string(),
+        ));
+    }
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
-    let binary = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let binary = extension.as_deref() == Some("glb");
     let (document, buffers) = gltf::open(&bytes, &origin, path.parent(), binary)?;
 
     let hierarchy = Hierarchy::of(&document).map_err(fail)?;

@@ -219,7 +219,7 @@ pub fn run_nodes(resolved: &Resolved, input: &OrderInput, keyframes: &Keyframes)
 }
 
 /// The error a per-node method gives when asked for one order.
-pub(crate) fn needs_nodes(method: &str) -> Error {
+pub fn needs_nodes(method: &str) -> Error {
     Error::usage(format!(
         "method `{method}` draws with several index buffers chosen per keyframe and view, not one order: \
          measure it with `triorder eval` (add --views; for an animation, --clip), or in an experiment"

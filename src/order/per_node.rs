@@ -2,44 +2,41 @@
 //! one per draw (Han & Sander 2017, §3.3 "Runtime selection").
 //!
 //! The table is indexed by keyframe, polar angle θ and azimuth φ of the direction from the model's
-//! (framed) centre to the eye. θ is measured from +Y, the up axis of glTF, in [`POLAR_STEPS`]
-//! values from 0 to π inclusive (the poles are cells of their own), and φ = atan2(z, x) in
-//! [`AZIMUTH_STEPS`] values around the circle. A query rounds f, θ and φ to the nearest stored
-//! values, as the paper does, so the choice costs a few arithmetic operations and one load. Each
-//! cell holds the buffer of the optimization viewpoint nearest to the cell's direction ("we use
-//! values from the closest original viewpoint when populating the table"). With 10° steps the
-//! cells are finer than the 17° spacing of the 162 icosahedron viewpoints the paper optimizes for.
+//! (framed) centre to the eye. θ is measured from +Y, the up axis of glTF, in evenly spaced values
+//! from 0 to π inclusive (the poles are cells of their own), and φ = atan2(z, x) in twice as many
+//! values around the circle. A query rounds f, θ and φ to the nearest stored values, as the paper
+//! does, so the choice costs a few arithmetic operations and one load. Each cell holds the buffer
+//! of the optimization viewpoint nearest to the cell's direction ("we use values from the closest
+//! original viewpoint when populating the table"). The angular step is a third of the spacing of
+//! the viewpoints (at most [`MAX_STEP_DEGREES`]), so a query from a viewpoint's own direction
+//! rounds to a cell that viewpoint fills: 5° for the paper's 162 viewpoints, 2.7° for 642.
 
 use glam::Vec3;
 
 use super::Order;
 
-/// Polar-angle samples from 0 to π inclusive: 10° apart.
-pub const POLAR_STEPS: usize = 19;
-/// Azimuth samples around the circle: 10° apart.
-pub const AZIMUTH_STEPS: usize = 36;
+/// The coarsest angular step of a table: 10°.
+pub const MAX_STEP_DEGREES: f32 = 10.0;
 
 /// The runtime choice of index buffer by (keyframe, θ, φ).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Lookup {
     frames: usize,
-    /// `frames × POLAR_STEPS × AZIMUTH_STEPS` buffer ids, frame-major.
+    /// θ samples from 0 to π inclusive; φ has `2 (polar − 1)` samples (one when `polar` is 1).
+    polar: usize,
+    /// `frames × polar × azimuth` buffer ids, frame-major.
     table: Vec<u16>,
 }
 
 impl Lookup {
     /// Every (frame, direction) uses buffer 0: what a single static order needs.
     pub fn uniform(frames: usize) -> Lookup {
-        Lookup { frames, table: vec![0; frames * POLAR_STEPS * AZIMUTH_STEPS] }
+        Lookup { frames, polar: 1, table: vec![0; frames] }
     }
 
     /// Frame `f` uses buffer `buffer_of_frame[f]` from every direction.
     pub fn per_frame(buffer_of_frame: &[u16]) -> Lookup {
-        let cells = POLAR_STEPS * AZIMUTH_STEPS;
-        Lookup {
-            frames: buffer_of_frame.len(),
-            table: buffer_of_frame.iter().flat_map(|&b| std::iter::repeat_n(b, cells)).collect(),
-        }
+        Lookup { frames: buffer_of_frame.len(), polar: 1, table: buffer_of_frame.to_vec() }
     }
 
     /// Fills every cell of every frame from the nearest of `viewpoints` (unit directions):
@@ -47,30 +44,41 @@ impl Lookup {
     pub fn nearest(viewpoints: &[Vec3], assignment: &[u16]) -> Lookup {
         assert!(!viewpoints.is_empty() && assignment.len().is_multiple_of(viewpoints.len()));
         let frames = assignment.len() / viewpoints.len();
-        let nearest: Vec<usize> = cell_directions()
+        // Mean angular spacing of n points spread over the sphere: √(4π / n).
+        let spacing = (4.0 * std::f32::consts::PI / viewpoints.len() as f32).sqrt();
+        let step = (spacing / 3.0).min(MAX_STEP_DEGREES.to_radians());
+        // The smallest whole number of steps no longer than `step` (a hair of slack for rounding).
+        let polar = (std::f32::consts::PI / step - 1e-4).ceil() as usize + 1;
+        let nearest: Vec<usize> = cell_directions(polar)
             .map(|d| {
                 (0..viewpoints.len()).max_by(|&a, &b| d.dot(viewpoints[a]).total_cmp(&d.dot(viewpoints[b]))).unwrap()
             })
             .collect();
         let table =
             (0..frames).flat_map(|f| nearest.iter().map(move |&v| assignment[f * viewpoints.len() + v])).collect();
-        Lookup { frames, table }
+        Lookup { frames, polar, table }
     }
 
     /// The buffer to draw keyframe `frame` with, seen from `direction` (centre → eye, any
     /// length; a zero direction reads as looking down from +Y). Frames past the end clamp.
     #[inline]
     pub fn buffer(&self, frame: usize, direction: Vec3) -> usize {
+        let (polar, azimuth) = (self.polar, azimuth_steps(self.polar));
         let d = direction.normalize_or(Vec3::Y);
-        let polar = d.y.clamp(-1.0, 1.0).acos() * ((POLAR_STEPS - 1) as f32 / std::f32::consts::PI);
-        let azimuth = d.z.atan2(d.x).rem_euclid(std::f32::consts::TAU) * (AZIMUTH_STEPS as f32 / std::f32::consts::TAU);
-        let (i, j) = (polar.round() as usize, azimuth.round() as usize % AZIMUTH_STEPS);
+        let theta = d.y.clamp(-1.0, 1.0).acos() * ((polar - 1) as f32 / std::f32::consts::PI);
+        let phi = d.z.atan2(d.x).rem_euclid(std::f32::consts::TAU) * (azimuth as f32 / std::f32::consts::TAU);
+        let (i, j) = (theta.round() as usize, phi.round() as usize % azimuth);
         let f = frame.min(self.frames - 1);
-        usize::from(self.table[(f * POLAR_STEPS + i) * AZIMUTH_STEPS + j])
+        usize::from(self.table[(f * polar + i) * azimuth + j])
     }
 
     pub fn frames(&self) -> usize {
         self.frames
+    }
+
+    /// Cells per keyframe: θ samples × φ samples.
+    pub fn cells_per_frame(&self) -> usize {
+        self.polar * azimuth_steps(self.polar)
     }
 
     /// Every cell's buffer id, frame-major, then θ, then φ.
@@ -79,12 +87,17 @@ impl Lookup {
     }
 }
 
-/// The unit direction of each (θ, φ) cell, θ-major.
-pub fn cell_directions() -> impl Iterator<Item = Vec3> {
-    (0..POLAR_STEPS).flat_map(|i| {
-        let theta = i as f32 * std::f32::consts::PI / (POLAR_STEPS - 1) as f32;
-        (0..AZIMUTH_STEPS).map(move |j| {
-            let phi = j as f32 * std::f32::consts::TAU / AZIMUTH_STEPS as f32;
+fn azimuth_steps(polar: usize) -> usize {
+    (2 * (polar - 1)).max(1)
+}
+
+/// The unit direction of each (θ, φ) cell of a table with `polar` θ samples, θ-major.
+fn cell_directions(polar: usize) -> impl Iterator<Item = Vec3> {
+    let azimuth = azimuth_steps(polar);
+    (0..polar).flat_map(move |i| {
+        let theta = i as f32 * std::f32::consts::PI / (polar - 1).max(1) as f32;
+        (0..azimuth).map(move |j| {
+            let phi = j as f32 * std::f32::consts::TAU / azimuth as f32;
             Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
         })
     })
@@ -144,20 +157,34 @@ mod tests {
     #[test]
     fn per_frame_and_uniform_tables() {
         let lookup = Lookup::per_frame(&[3, 1, 2]);
-        for d in cell_directions() {
+        for d in cell_directions(19) {
             assert_eq!([0, 1, 2].map(|f| lookup.buffer(f, d)), [3, 1, 2]);
         }
+        assert_eq!(lookup.cells_per_frame(), 1);
         assert!(Lookup::uniform(4).cells().iter().all(|&b| b == 0));
     }
 
     #[test]
+    fn the_step_follows_the_viewpoint_spacing() {
+        let step = |n: usize| {
+            let lookup = Lookup::nearest(&vec![Vec3::Y; n], &vec![0; n]);
+            180.0 / (lookup.polar - 1) as f32
+        };
+        assert_eq!(step(12), 10.0);
+        assert!((5.0..5.4).contains(&step(162)), "{}", step(162));
+        assert!((2.5..2.8).contains(&step(642)), "{}", step(642));
+    }
+
+    #[test]
     fn cell_directions_are_unit_and_the_lookup_finds_each_cell_again() {
-        let dirs: Vec<Vec3> = cell_directions().collect();
-        assert_eq!(dirs.len(), POLAR_STEPS * AZIMUTH_STEPS);
+        let polar = 19;
+        let dirs: Vec<Vec3> = cell_directions(polar).collect();
+        let azimuth = azimuth_steps(polar);
+        assert_eq!(dirs.len(), polar * azimuth);
         // A table whose cell i holds i (poles excepted, where every φ is the same direction).
         let table: Vec<u16> = (0..dirs.len() as u16).collect();
-        let lookup = Lookup { frames: 1, table };
-        for (i, d) in dirs.iter().enumerate().skip(AZIMUTH_STEPS).take(dirs.len() - 2 * AZIMUTH_STEPS) {
+        let lookup = Lookup { frames: 1, polar, table };
+        for (i, d) in dirs.iter().enumerate().skip(azimuth).take(dirs.len() - 2 * azimuth) {
             assert!((d.length() - 1.0).abs() < 1e-5);
             assert_eq!(lookup.buffer(0, *d), i);
         }
