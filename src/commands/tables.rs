@@ -6,7 +6,7 @@ use serde_json::{Map, Value, json};
 use triorder::eval::{Evaluation, MeasureOptions, Measurement, NodeEvaluation};
 use triorder::mesh::Mesh;
 use triorder::mesh::keyframes::Keyframes;
-use triorder::metrics::OverdrawSummary;
+use triorder::metrics::{CacheModel, OverdrawSummary};
 
 /// `eval`'s readable table: one row per method, ACMR/ATVR per cache, OVR when measured.
 pub struct EvalTable {
@@ -74,19 +74,8 @@ fn summary_cell(summary: Option<OverdrawSummary>) -> String {
 /// `acmr`, `atvr` for the first cache, `seconds`, and with views `views`, `res`, `ovr_mean`,
 /// `ovr_max`), plus every cache under `caches` and the other overdraw statistics.
 pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
-    let mut o = Map::new();
-    o.insert("mesh".into(), json!(mesh.name));
-    o.insert("method".into(), json!(e.method));
-    o.insert("peer".into(), json!(e.peer));
-    o.insert("triangles".into(), json!(mesh.triangle_count()));
-    o.insert("vertices".into(), json!(mesh.vertex_count()));
-    o.insert("seconds".into(), json!(e.seconds));
-    o.insert("buffers".into(), json!(1));
-    if let Some((model, s)) = e.measurement.caches.first() {
-        o.insert("cache".into(), json!(model.to_string()));
-        o.insert("acmr".into(), json!(s.acmr()));
-        o.insert("atvr".into(), json!(s.atvr()));
-    }
+    let first = e.measurement.caches.first().map(|(model, s)| (model, s.acmr(), s.atvr()));
+    let mut o = head(mesh, &e.method, e.peer, e.seconds, 1, first);
     let caches: Vec<Value> = e
         .measurement
         .caches
@@ -104,6 +93,32 @@ pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
     Value::Object(o).to_string()
 }
 
+/// The fields every `eval --json` line starts with; `first` is the first cache model with its
+/// ACMR and ATVR.
+fn head(
+    mesh: &Mesh,
+    method: &str,
+    peer: bool,
+    seconds: f64,
+    buffers: usize,
+    first: Option<(&CacheModel, f64, f64)>,
+) -> Map<String, Value> {
+    let mut o = Map::new();
+    o.insert("mesh".into(), json!(mesh.name));
+    o.insert("method".into(), json!(method));
+    o.insert("peer".into(), json!(peer));
+    o.insert("triangles".into(), json!(mesh.triangle_count()));
+    o.insert("vertices".into(), json!(mesh.vertex_count()));
+    o.insert("seconds".into(), json!(seconds));
+    o.insert("buffers".into(), json!(buffers));
+    if let Some((model, acmr, atvr)) = first {
+        o.insert("cache".into(), json!(model.to_string()));
+        o.insert("acmr".into(), json!(acmr));
+        o.insert("atvr".into(), json!(atvr));
+    }
+    o
+}
+
 /// The overdraw statistics of one summary, under the names `eval --json` uses.
 fn insert_summary(o: &mut Map<String, Value>, s: Option<OverdrawSummary>, views: usize) {
     o.insert("ovr_mean".into(), json!(s.map(|s| s.mean)));
@@ -119,24 +134,13 @@ fn insert_summary(o: &mut Map<String, Value>, s: Option<OverdrawSummary>, views:
 /// `keyframes`, the optimizer's `iterations`, `converged` and `phases` (seconds per phase) where
 /// it reports them, and `clips` with each clip's overdraw when there are several.
 pub fn nodes_json(mesh: &Mesh, keyframes: &Keyframes, e: &NodeEvaluation, backend: &str) -> String {
-    let mut o = Map::new();
-    o.insert("mesh".into(), json!(mesh.name));
-    o.insert("method".into(), json!(e.method));
-    o.insert("peer".into(), json!(e.peer));
-    o.insert("triangles".into(), json!(mesh.triangle_count()));
-    o.insert("vertices".into(), json!(mesh.vertex_count()));
-    o.insert("seconds".into(), json!(e.seconds));
-    o.insert("buffers".into(), json!(e.nodes.buffers.len()));
+    let first = e.measurement.caches.first().map(|(model, acmr, atvr)| (model, *acmr, *atvr));
+    let mut o = head(mesh, &e.method, e.peer, e.seconds, e.nodes.buffers.len(), first);
     o.insert("keyframes".into(), json!(keyframes.len()));
     o.insert("iterations".into(), json!(e.nodes.iterations));
     o.insert("converged".into(), json!(e.nodes.converged));
     let phases: Map<String, Value> = e.nodes.phases.iter().map(|(p, s)| (p.to_string(), json!(s))).collect();
     o.insert("phases".into(), Value::Object(phases));
-    if let Some((model, acmr, atvr)) = e.measurement.caches.first() {
-        o.insert("cache".into(), json!(model.to_string()));
-        o.insert("acmr".into(), json!(acmr));
-        o.insert("atvr".into(), json!(atvr));
-    }
     let caches: Vec<Value> = e
         .measurement
         .caches
