@@ -454,3 +454,99 @@ fn simplified_models_are_named_with_their_triangle_count() {
         assert!(source::check(bad, None).is_err() || want == "only 5856");
     }
 }
+
+/// An animated spec small enough for a debug build: the bundled Fox (three clips) resampled to two
+/// frames per clip, and a static sphere, which a per-node method in the spec measures as one frame.
+const ANIMATED: &str = r#"
+id = "animated"
+title = "Animated experiment"
+question = "Does the pipeline measure index buffers per clip?"
+models = ["assets/Fox.glb#frames=2"]
+methods = ["tipsify", "hs17:clusters=2,views=12,res=32,iterations=3"]
+caches = ["fifo:16"]
+views = "axis6"
+res = 32
+
+[figure]
+kind = "bar"
+metric = "seconds"
+x = "method_name"
+facet = "model"
+label = "metric:buffers"
+
+[quick]
+models = ["assets/Fox.glb#frames=2", "sphere:80"]
+"#;
+
+#[test]
+fn animated_runs_write_buffers_and_a_row_per_clip() {
+    let root = tempfile::tempdir().unwrap();
+    let path = write_spec(root.path(), "animated", ANIMATED);
+    let (header, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
+    assert_eq!(header, COLUMNS);
+    let find = |model: &str, method: &str, metric: &str, clip: &str| {
+        let found: Vec<f64> = rows
+            .iter()
+            .filter(|r| r["model"] == model && r["method_name"] == method && r["metric"] == metric && r["clip"] == clip)
+            .map(|r| r["value"].parse().unwrap())
+            .collect();
+        assert!(found.len() <= 1, "several {metric} rows for {model} {method} {clip}");
+        found.first().copied()
+    };
+    let fox = "assets/Fox.glb#frames=2";
+    // Static methods need one buffer; hs17 at most two per clip, and says how it iterated.
+    assert_eq!(find(fox, "tipsify", "buffers", "all"), Some(1.0));
+    let buffers = find(fox, "hs17", "buffers", "all").unwrap();
+    assert!((2.0..=6.0).contains(&buffers), "{buffers}");
+    assert!(find(fox, "hs17", "iterations", "all").is_some_and(|i| (1.0..=3.0).contains(&i)));
+    assert!(find(fox, "hs17", "converged", "all").is_some_and(|c| c == 0.0 || c == 1.0));
+    assert_eq!(find(fox, "tipsify", "iterations", "all"), None);
+    // Overdraw over all frames and per clip; caches and times once, under `all`.
+    for method in ["tipsify", "hs17"] {
+        for clip in ["all", "Survey", "Walk", "Run"] {
+            let ovr = find(fox, method, "ovr_mean", clip).unwrap_or_else(|| panic!("{method} {clip}"));
+            assert!(ovr >= 1.0, "{ovr}");
+        }
+        // Fox is not indexed: every triangle misses three times, whatever the order.
+        assert_eq!(find(fox, method, "acmr", "all"), Some(3.0));
+        assert_eq!(find(fox, method, "acmr", "Walk"), None);
+    }
+    // A static model in a spec with a per-node method: one frame, no clip.
+    assert!(rows.iter().filter(|r| r["model"] == "sphere:80").all(|r| r["clip"].is_empty()));
+    assert_eq!(find("sphere:80", "tipsify", "buffers", ""), Some(1.0));
+    assert!(find("sphere:80", "hs17", "ovr_mean", "").is_some());
+    // The bars carry the buffer counts above them.
+    let svg = std::fs::read_to_string(plot(&path, &plot_quick(root.path())).unwrap()).unwrap();
+    let texts: Vec<&str> = svg.split("</text>").filter_map(|t| Some(t.rsplit_once('>')?.1.trim())).collect();
+    assert!(texts.contains(&buffers.to_string().as_str()), "no buffer count label in the SVG: {texts:?}");
+}
+
+#[test]
+fn animated_specs_are_checked_before_any_work() {
+    let cases: &[(&str, &str, &[&str])] = &[
+        ("#frames=2\", \"sphere", "#frames=x\", \"sphere", &["quick.models[0]", "frames `x`"]),
+        ("kind = \"bar\"", "kind = \"line\"", &["figure.label", "bar"]),
+        ("label = \"metric:buffers\"", "label = \"metric:nope\"", &["figure.label", "nope"]),
+        ("x = \"method_name\"", "x = \"source:speed\"", &["figure.x", "source:speed", "clip, frames, subdiv"]),
+        (
+            "kind = \"bar\"\nmetric = \"seconds\"\nx = \"method_name\"\nfacet = \"model\"\nlabel = \"metric:buffers\"",
+            "kind = \"clusters\"\nmetric = \"acmr\"",
+            &["kind = \"clusters\"", "hs17", "index buffer per (keyframe, view)"],
+        ),
+    ];
+    for (from, to, expected) in cases {
+        assert!(ANIMATED.contains(from), "{from}");
+        let err = spec_error("animated", &ANIMATED.replacen(from, to, 1));
+        for want in *expected {
+            assert!(err.contains(want), "`{to}`: error lacks `{want}`:\n{err}");
+        }
+    }
+    // A clip the file does not have fails the run before anything is ordered or written.
+    let root = tempfile::tempdir().unwrap();
+    let path = write_spec(root.path(), "animated", &ANIMATED.replace("#frames=2\", \"sphere", "#clip=Fly\", \"sphere"));
+    let err = run(&path, &quick(root.path())).unwrap_err().to_string();
+    for want in [path.display().to_string().as_str(), "quick.models[0]", "Fly", "Survey"] {
+        assert!(err.contains(want), "error lacks `{want}`: {err}");
+    }
+    assert!(!root.path().join("results").exists());
+}

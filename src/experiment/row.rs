@@ -8,8 +8,9 @@
 
 use serde::Serialize;
 
-use crate::eval::Evaluation;
+use crate::eval::{Evaluation, NodeEvaluation, Overdraw};
 use crate::mesh::{Mesh, simplify};
+use crate::metrics::CacheModel;
 
 /// The CSV header, in order (checked against [`Row`] by a test).
 pub const COLUMNS: &[&str] = &[
@@ -18,6 +19,7 @@ pub const COLUMNS: &[&str] = &[
     "model_base",
     "model_triangles",
     "model_vertices",
+    "clip",
     "method",
     "method_name",
     "peer",
@@ -54,12 +56,17 @@ pub struct Metric {
 }
 
 /// Every metric a run writes. Cache metrics come once per cache model; overdraw summaries once
-/// per view set; `ovr` once per view that sees the mesh (empty views have no ratio and are
-/// counted by `ovr_empty` instead), and only when the spec's figure draws `ovr`.
+/// per view set (for an animation: once over all frames and once per clip); `ovr` once per view
+/// that sees the mesh (empty views have no ratio and are counted by `ovr_empty` instead), and
+/// only when the spec's figure draws `ovr`. Runs of animations, or of keyframe- and view-dependent
+/// methods, also write `buffers`, and `iterations` and `converged` for methods that iterate.
 pub const METRICS: &[Metric] = &[
     Metric { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: Needs::Caches },
     Metric { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: Needs::Caches },
     Metric { name: "seconds", label: "ordering time (s)", needs: Needs::Nothing },
+    Metric { name: "buffers", label: "index buffers", needs: Needs::Nothing },
+    Metric { name: "iterations", label: "optimization iterations", needs: Needs::Nothing },
+    Metric { name: "converged", label: "converged before the iteration cap (1) or not (0)", needs: Needs::Nothing },
     Metric { name: "ovr", label: "overdraw ratio (shaded ÷ covered pixels)", needs: Needs::Views },
     Metric { name: "ovr_mean", label: "mean overdraw ratio over views", needs: Needs::Views },
     Metric { name: "ovr_max", label: "worst-view overdraw ratio", needs: Needs::Views },
@@ -78,6 +85,9 @@ pub struct Row {
     pub model_base: String,
     pub model_triangles: usize,
     pub model_vertices: usize,
+    /// For an animation, the clip a row measures, or `all` for all its frames (and for the rows
+    /// that do not depend on the clip: times, caches, buffers); empty for a static mesh.
+    pub clip: Option<String>,
     /// Canonical method spec (every parameter).
     pub method: String,
     pub method_name: String,
@@ -117,15 +127,62 @@ pub struct Context {
 impl Context {
     /// The rows of one evaluation of `model` (as the spec names it).
     pub fn rows(&self, model: &str, mesh: &Mesh, method_name: &str, eval: &Evaluation) -> Vec<Row> {
-        let base = Row {
+        let base = self.base(model, mesh, &eval.method, method_name, eval.peer, eval.seconds);
+        let mut rows = Vec::new();
+        for (cache, stats) in &eval.measurement.caches {
+            rows.extend(cache_rows(&base, cache, stats.acmr(), stats.atvr()));
+        }
+        if let Some(overdraw) = &eval.measurement.overdraw {
+            self.overdraw_rows(&base, overdraw, &mut rows);
+        }
+        rows.push(base);
+        rows
+    }
+
+    /// The rows of one index-buffer evaluation of `model` (as the spec names it): draw-weighted
+    /// cache metrics, overdraw over all frames (clip `all`, or empty when `animated` is false:
+    /// a static mesh seen as one frame) and per clip, the time, and how many buffers the method
+    /// needs, with its iterations and whether it converged when it reports them.
+    pub fn node_rows(
+        &self,
+        model: &str,
+        mesh: &Mesh,
+        method_name: &str,
+        eval: &NodeEvaluation,
+        animated: bool,
+    ) -> Vec<Row> {
+        let all = animated.then(|| "all".to_string());
+        let base =
+            Row { clip: all.clone(), ..self.base(model, mesh, &eval.method, method_name, eval.peer, eval.seconds) };
+        let mut rows = Vec::new();
+        for &(cache, acmr, atvr) in &eval.measurement.caches {
+            rows.extend(cache_rows(&base, &cache, acmr, atvr));
+        }
+        for clip in &eval.measurement.overdraw {
+            let clip_base = Row { clip: clip.clip.clone().or(all.clone()), ..base.clone() };
+            self.overdraw_rows(&clip_base, &clip.overdraw, &mut rows);
+        }
+        rows.push(Row { metric: "buffers", value: eval.nodes.buffers.len() as f64, ..base.clone() });
+        if let Some(iterations) = eval.nodes.iterations {
+            rows.push(Row { metric: "iterations", value: iterations as f64, ..base.clone() });
+            rows.push(Row { metric: "converged", value: f64::from(u8::from(eval.nodes.converged)), ..base.clone() });
+        }
+        rows.push(base);
+        rows
+    }
+
+    /// The `seconds` row of an evaluation (no clip), which every other row of it copies.
+    fn base(&self, model: &str, mesh: &Mesh, method: &str, method_name: &str, peer: bool, seconds: f64) -> Row {
+        Row {
             experiment: self.experiment.clone(),
             model: model.to_string(),
             model_base: simplify::parse_source(model).map_or(model, |(base, _)| base).to_string(),
             model_triangles: mesh.triangle_count(),
             model_vertices: mesh.vertex_count(),
-            method: eval.method.clone(),
+            clip: None,
+            method: method.to_string(),
             method_name: method_name.to_string(),
-            peer: eval.peer,
+            peer,
             seed: self.seed,
             metric: "seconds",
             cache: None,
@@ -135,47 +192,47 @@ impl Context {
             res: None,
             view: None,
             backend: self.backend.clone(),
-            value: eval.seconds,
-            seconds: eval.seconds,
+            value: seconds,
+            seconds,
             machine: self.machine.clone(),
             commit: self.commit.clone(),
             triorder: env!("CARGO_PKG_VERSION"),
-        };
-        let mut rows = Vec::new();
-        for (model, stats) in &eval.measurement.caches {
-            let cache = Row {
-                cache: Some(model.to_string()),
-                cache_kind: Some(model.kind()),
-                cache_size: Some(model.size()),
-                ..base.clone()
-            };
-            rows.push(Row { metric: "acmr", value: stats.acmr(), ..cache.clone() });
-            rows.push(Row { metric: "atvr", value: stats.atvr(), ..cache });
         }
-        if let Some(overdraw) = &eval.measurement.overdraw {
-            let views = Row { views: Some(overdraw.views.to_string()), res: Some(overdraw.res), ..base.clone() };
-            let empty = overdraw.per_view.iter().filter(|v| v.ovr().is_none()).count();
-            rows.push(Row { metric: "ovr_empty", value: empty as f64, ..views.clone() });
-            if let Some(s) = &overdraw.summary {
-                for (metric, value) in [
-                    ("ovr_mean", s.mean),
-                    ("ovr_max", s.max),
-                    ("ovr_min", s.min),
-                    ("ovr_var", s.variance),
-                    ("ovr_sum", s.ratio_of_sums),
-                ] {
-                    rows.push(Row { metric, value, ..views.clone() });
-                }
-            }
-            for (i, counts) in overdraw.per_view.iter().enumerate().filter(|_| self.per_view) {
-                if let Some(value) = counts.ovr() {
-                    rows.push(Row { metric: "ovr", view: Some(i), value, ..views.clone() });
-                }
-            }
-        }
-        rows.push(base);
-        rows
     }
+
+    /// The overdraw rows of one view set (and, for an animation, one clip) appended to `rows`.
+    fn overdraw_rows(&self, base: &Row, overdraw: &Overdraw, rows: &mut Vec<Row>) {
+        let views = Row { views: Some(overdraw.views.to_string()), res: Some(overdraw.res), ..base.clone() };
+        let empty = overdraw.per_view.iter().filter(|v| v.ovr().is_none()).count();
+        rows.push(Row { metric: "ovr_empty", value: empty as f64, ..views.clone() });
+        if let Some(s) = &overdraw.summary {
+            for (metric, value) in [
+                ("ovr_mean", s.mean),
+                ("ovr_max", s.max),
+                ("ovr_min", s.min),
+                ("ovr_var", s.variance),
+                ("ovr_sum", s.ratio_of_sums),
+            ] {
+                rows.push(Row { metric, value, ..views.clone() });
+            }
+        }
+        for (i, counts) in overdraw.per_view.iter().enumerate().filter(|_| self.per_view) {
+            if let Some(value) = counts.ovr() {
+                rows.push(Row { metric: "ovr", view: Some(i), value, ..views.clone() });
+            }
+        }
+    }
+}
+
+/// The `acmr` and `atvr` rows of one cache model.
+fn cache_rows(base: &Row, cache: &CacheModel, acmr: f64, atvr: f64) -> [Row; 2] {
+    let cache = Row {
+        cache: Some(cache.to_string()),
+        cache_kind: Some(cache.kind()),
+        cache_size: Some(cache.size()),
+        ..base.clone()
+    };
+    [Row { metric: "acmr", value: acmr, ..cache.clone() }, Row { metric: "atvr", value: atvr, ..cache }]
 }
 
 /// One line of a drawing spec's orders file: a whole order, the triangle ids in draw order
@@ -202,6 +259,7 @@ mod tests {
             model_base: String::new(),
             model_triangles: 0,
             model_vertices: 0,
+            clip: None,
             method: String::new(),
             method_name: String::new(),
             peer: false,

@@ -2,8 +2,11 @@
 //! the view set, one CSV row per number.
 //!
 //! Models are handled one at a time (load, topology, then every method) so memory stays that of
-//! the largest model. Orderings run one after another so their wall times are honest; only the
-//! rasterizer runs in parallel, inside one measurement. The CSV is written atomically at the end:
+//! the largest model. An animation (`PATH#clip=…`) is read and posed once and every method is
+//! measured over its keyframes with the index buffers it picks per (keyframe, view) (Han & Sander
+//! 2017, §4); so is a static model, as one frame, when a method of the spec gives several buffers,
+//! so that all methods on it are measured the same way. Orderings run one after another so their
+//! wall times are honest; only the rasterizer runs in parallel, inside one measurement. The CSV is written atomically at the end:
 //! an interrupted run leaves the previous results untouched.
 
 use std::path::{Path, PathBuf};
@@ -14,9 +17,10 @@ use super::provenance;
 use super::row::{Context, OrderRow, Row};
 use super::spec::Spec;
 use crate::error::{Error, Result};
-use crate::eval::{MeasureOptions, evaluate};
+use crate::eval::{MeasureOptions, evaluate, evaluate_nodes};
+use crate::mesh::keyframes::Keyframes;
 use crate::mesh::report::MeshReport;
-use crate::mesh::source;
+use crate::mesh::source::{self, AnimationSource};
 use crate::order;
 use crate::topology::Topology;
 use crate::{atomic, figure, raster};
@@ -114,25 +118,43 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
     let mut rows: Vec<Row> = Vec::new();
     let mut orders: Vec<OrderRow> = Vec::new();
     let save_orders = spec.figure.kind.draws_meshes();
+    let per_node = methods.iter().any(|m| m.method.per_node);
     for model in &work.models {
         bar.set_message(format!("{model}: loading"));
-        let mesh = source::open(model, data.as_deref(), spec.seed)?;
+        let animation = AnimationSource::parse(model).transpose()?;
+        let (mesh, keyframes) = match &animation {
+            Some(animation) => {
+                let (mesh, keyframes) = animation.open(data.as_deref())?;
+                (mesh, Some(keyframes))
+            }
+            None => {
+                let mesh = source::open(model, data.as_deref(), spec.seed)?;
+                let still = per_node.then(|| Keyframes::still(&mesh));
+                (mesh, still)
+            }
+        };
         let topology = Topology::new(&mesh);
         for warning in MeshReport::new(&mesh, &topology).warnings() {
             bars.suspend(|| eprintln!("{model}: note: {warning}"));
         }
         for method in &methods {
             bar.set_message(format!("{model} · {}", method.canonical()));
-            let evaluation = evaluate(&mesh, &topology, method, &measure, raster.as_ref())?;
-            rows.extend(context.rows(model, &mesh, method.method.name, &evaluation));
-            if save_orders {
-                let words = |values: &mut dyn Iterator<Item = String>| values.collect::<Vec<_>>().join(" ");
-                orders.push(OrderRow {
-                    model: model.clone(),
-                    method: evaluation.method.clone(),
-                    order: words(&mut evaluation.order.iter().map(u32::to_string)),
-                    clusters: words(&mut evaluation.cluster_starts.iter().map(usize::to_string)),
-                });
+            let name = method.method.name;
+            if let Some(keyframes) = &keyframes {
+                let evaluation = evaluate_nodes(&mesh, &topology, keyframes, method, &measure, raster.as_ref())?;
+                rows.extend(context.node_rows(model, &mesh, name, &evaluation, animation.is_some()));
+            } else {
+                let evaluation = evaluate(&mesh, &topology, method, &measure, raster.as_ref())?;
+                rows.extend(context.rows(model, &mesh, name, &evaluation));
+                if save_orders {
+                    let words = |values: &mut dyn Iterator<Item = String>| values.collect::<Vec<_>>().join(" ");
+                    orders.push(OrderRow {
+                        model: model.clone(),
+                        method: evaluation.method.clone(),
+                        order: words(&mut evaluation.order.iter().map(u32::to_string)),
+                        clusters: words(&mut evaluation.cluster_starts.iter().map(usize::to_string)),
+                    });
+                }
             }
             bar.inc(1);
         }

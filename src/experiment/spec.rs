@@ -16,7 +16,9 @@
 //!                                  # caption under the title
 //! models = ["models/bunny_2k.ply", "sphere:20480"]
 //!                                  # paths (tried as given, then in the data directory: --data,
-//!                                  # TRIORDER_DATA, ../shared/data) or procedural specs
+//!                                  # TRIORDER_DATA, ../shared/data) or procedural specs; an
+//!                                  # animation is PATH#clip=NAME,frames=N,subdiv=L (every method
+//!                                  # measured over its keyframes, rows per clip)
 //! methods = "all"                  # every registered method with its defaults, or a list of
 //!                                  # method specs; any parameter may be a grid:
 //!                                  # ["input", "meshopt-fifo:cache={8,16,32}", "random:seed={1..3}"]
@@ -41,8 +43,10 @@
 //!                                  # table: its rows;
 //!                                  # distribution: not allowed, it sorts the values itself).
 //!                                  # x, series, facet and filter keys may also name a method
-//!                                  # parameter, "param:clusters"; a scatter's x may name another
-//!                                  # metric of the same model and method, "metric:acmr"
+//!                                  # parameter, "param:clusters", or a key of an animated
+//!                                  # model, "source:subdiv" (clip, frames, subdiv); a scatter's x
+//!                                  # may name another metric of the same model and method,
+//!                                  # "metric:acmr"
 //! series = "method"                # optional (default method): one colour per value
 //! facet = "model"                  # optional: one small chart per value, all in one SVG
 //! filter = { cache_kind = "fifo" } # optional: keep only rows whose columns equal these values
@@ -51,6 +55,8 @@
 //! x_log = false                    # optional log axes (default false)
 //! y_log = false
 //! y_range = [0.5, 3.2]             # optional y axis range (default: fits the data)
+//! label = "metric:iterations"      # bar: write this metric of the same model and method above
+//!                                  # each bar instead of the bar's value
 //! view = [0, 0, 1]                 # sequence, corners: direction the model is seen from
 //!
 //! [quick]                          # what `--quick` runs: procedural models and assets/ only,
@@ -71,6 +77,7 @@ use serde::Deserialize;
 
 use super::row::{COLUMNS, METRICS, Needs};
 use crate::error::{Error, Result};
+use crate::mesh::source::AnimationSource;
 use crate::mesh::{procedural, simplify};
 use crate::metrics::CacheModel;
 use crate::order::{self, METHODS};
@@ -134,6 +141,9 @@ pub struct Figure {
     pub x_log: bool,
     pub y_log: bool,
     pub y_range: Option<(f64, f64)>,
+    /// Bars: `metric:NAME`, the metric written above each bar instead of its value (e.g. the
+    /// iterations an ordering took above its time, Han & Sander 2017 Fig. 5).
+    pub label: Option<String>,
     /// Drawing kinds: the direction the model is seen from (centre → eye), default +z.
     pub view: [f32; 3],
 }
@@ -292,6 +302,7 @@ struct RawFigure {
     #[serde(default)]
     y_log: bool,
     y_range: Option<[f64; 2]>,
+    label: Option<String>,
     view: Option<[f32; 3]>,
 }
 
@@ -351,6 +362,16 @@ impl RawSpec {
             }
         };
         let figure = self.figure.check(&full, &methods).map_err(err)?;
+        if figure.kind.draws_meshes() {
+            let per_node = methods.iter().find(|m| order::resolve(m, self.seed).is_ok_and(|r| r.method.per_node));
+            let animated = full.models.iter().chain(quick.iter().flat_map(|q| &q.models)).find(|m| is_animation(m));
+            if let Some(what) = per_node.map(|m| format!("method `{m}`")).or(animated.map(|m| format!("model `{m}`"))) {
+                return Err(err(format!(
+                    "figure.kind = \"{}\" draws one order per model and method, but {what} gives an index buffer per (keyframe, view): use a chart kind (line, bar, table, …)",
+                    kind_name(figure.kind)
+                )));
+            }
+        }
         Ok(Spec {
             path: path.to_path_buf(),
             id: self.id,
@@ -365,6 +386,11 @@ impl RawSpec {
             figure,
         })
     }
+}
+
+/// True for animated models (`PATH#…`).
+fn is_animation(model: &str) -> bool {
+    AnimationSource::parse(model).is_some()
 }
 
 /// True for models a fresh clone has: procedural specs and the bundled `assets/` files.
@@ -420,6 +446,11 @@ fn check_workload(
     if let Some((i, _)) = models.iter().enumerate().find(|(_, m)| m.trim().is_empty()) {
         return Err(format!("{prefix}models[{i}] is empty"));
     }
+    for (i, model) in models.iter().enumerate() {
+        if let Some(Err(e)) = AnimationSource::parse(model) {
+            return Err(format!("{prefix}models[{i}]: {e}"));
+        }
+    }
     let mut parsed = Vec::new();
     for (i, text) in caches.iter().enumerate() {
         let key = format!("{prefix}caches[{i}]");
@@ -473,9 +504,22 @@ impl RawFigure {
         if metrics.len() > 1 && self.series.as_deref() != Some("metric") && self.facet.as_deref() != Some("metric") {
             return Err("figure.metric lists several metrics: set figure.series or figure.facet to \"metric\"".into());
         }
-        // A CSV column; `param:NAME`, a parameter of the spec's methods; or, where `metric_ok`,
-        // `metric:NAME`, another metric joined on model and method.
+        // A CSV column; `param:NAME`, a parameter of the spec's methods; `source:KEY`, a key of its
+        // animated models; or, where `metric_ok`, `metric:NAME`, another metric joined on model
+        // and method.
         let column = |key: &str, name: &str, metric_ok: bool| {
+            if let Some(source_key) = name.strip_prefix("source:") {
+                if !crate::figure::data::SOURCE_KEYS.contains(&source_key) {
+                    return Err(format!(
+                        "{key} `{name}`: `{source_key}` is not a key of an animated model (keys: {})",
+                        crate::figure::data::SOURCE_KEYS.join(", ")
+                    ));
+                }
+                if !full.models.iter().any(|m| is_animation(m)) {
+                    return Err(format!("{key} `{name}`: no model of this spec is an animation (PATH#…)"));
+                }
+                return Ok(());
+            }
             if let Some(param) = name.strip_prefix("param:") {
                 if methods.iter().any(|m| crate::figure::data::parameter(m, param).is_some()) {
                     return Ok(());
@@ -492,7 +536,7 @@ impl RawFigure {
                 Ok(())
             } else {
                 Err(format!(
-                    "{key} `{name}` is not a CSV column (columns: {}; or param:NAME{})",
+                    "{key} `{name}` is not a CSV column (columns: {}; or param:NAME, source:KEY{})",
                     COLUMNS.join(", "),
                     if metric_ok { ", metric:NAME" } else { "" }
                 ))
@@ -547,6 +591,15 @@ impl RawFigure {
             };
             filter.push((key, value));
         }
+        if let Some(label) = &self.label {
+            if self.kind != FigureKind::Bar {
+                return Err(format!("figure.label is for kind = \"bar\", not \"{}\"", kind_name(self.kind)));
+            }
+            if !label.starts_with("metric:") {
+                return Err(format!("figure.label `{label}`: expected metric:NAME"));
+            }
+            column("figure.label", label, true)?;
+        }
         let y_range = match self.y_range {
             Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
                 return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
@@ -569,6 +622,7 @@ impl RawFigure {
             x_log: self.x_log,
             y_log: self.y_log,
             y_range,
+            label: self.label,
             view,
         })
     }

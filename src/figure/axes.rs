@@ -18,6 +18,7 @@ pub type DrawResult = std::result::Result<(), DrawingAreaErrorKind<std::io::Erro
 pub const FONT: &str = "sans-serif";
 
 /// Axes shared by every panel of a figure.
+#[derive(Clone)]
 pub struct Frame {
     pub x: Range<f64>,
     pub y: Range<f64>,

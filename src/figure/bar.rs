@@ -1,6 +1,7 @@
 //! Grouped bar charts: one group per x category (e.g. per model), one bar per series in each
-//! group, always at the same place in its group so a series is found at a glance, its value
-//! written on top when the bar is wide enough.
+//! group, always at the same place in its group so a series is found at a glance, its value (or
+//! the figure's `label`, another metric of the same ordering) written on top when the bar is wide
+//! enough.
 
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::prelude::*;
@@ -20,6 +21,8 @@ pub struct Bars {
     pub categories: Vec<String>,
     pub series: Vec<String>,
     pub values: Vec<Vec<Vec<Option<f64>>>>,
+    /// The same shape: the text written above each bar instead of its value, where not empty.
+    pub labels: Vec<Vec<Vec<String>>>,
 }
 
 impl Bars {
@@ -36,19 +39,27 @@ impl Bars {
                 }
             }
         }
-        let values = panels
-            .iter()
-            .map(|panel| {
-                series
+        let (mut values, mut labels) = (Vec::new(), Vec::new());
+        for panel in panels {
+            let (mut panel_values, mut panel_labels) = (Vec::new(), Vec::new());
+            for name in &series {
+                let found = panel.series.iter().find(|s| s.name == *name);
+                let (v, l): (Vec<Option<f64>>, Vec<String>) = categories
                     .iter()
-                    .map(|name| {
-                        let points = panel.series.iter().find(|s| s.name == *name).map_or(&[][..], |s| &s.points);
-                        categories.iter().map(|c| points.iter().find(|(x, _)| x == c).map(|&(_, y)| y)).collect()
+                    .map(|c| {
+                        let point = found.and_then(|s| Some((s, s.points.iter().position(|(x, _)| x == c)?)));
+                        point.map_or((None, String::new()), |(s, i)| {
+                            (Some(s.points[i].1), s.labels.get(i).cloned().unwrap_or_default())
+                        })
                     })
-                    .collect()
-            })
-            .collect();
-        Bars { categories, series, values }
+                    .unzip();
+                panel_values.push(v);
+                panel_labels.push(l);
+            }
+            values.push(panel_values);
+            labels.push(panel_labels);
+        }
+        Bars { categories, series, values, labels }
     }
 }
 
@@ -66,19 +77,44 @@ impl Kind for Bars {
         Swatch::Block
     }
 
+    /// A panel shows only the categories it has values for (characters have different clips), so
+    /// it is not padded with empty slots for the other panels' categories.
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult {
+        let values = &self.values[index];
+        let mut own: Vec<usize> =
+            (0..self.categories.len()).filter(|&i| values.iter().any(|s| s[i].is_some())).collect();
+        if own.is_empty() {
+            own = (0..self.categories.len()).collect();
+        }
+        let frame = Frame {
+            x: -0.5..own.len() as f64 - 0.5,
+            categories: Some(own.iter().map(|&i| self.categories[i].clone()).collect()),
+            ..frame.clone()
+        };
         axes::panel(
             area,
             title,
-            frame,
-            &BarPainter { bars: self, values: &self.values[index], colors, base: frame.y.start },
+            &frame,
+            &BarPainter {
+                bars: self,
+                values: &keep_columns(values, &own),
+                labels: &keep_columns(&self.labels[index], &own),
+                colors,
+                base: frame.y.start,
+            },
         )
     }
+}
+
+/// Each row of `rows` cut to the columns `keep`, in that order.
+fn keep_columns<T: Clone>(rows: &[Vec<T>], keep: &[usize]) -> Vec<Vec<T>> {
+    rows.iter().map(|row| keep.iter().map(|&i| row[i].clone()).collect()).collect()
 }
 
 struct BarPainter<'a> {
     bars: &'a Bars,
     values: &'a [Vec<Option<f64>>],
+    labels: &'a [Vec<String>],
     colors: &'a Colors,
     /// Where bars start: 0, or the bottom of a log axis.
     base: f64,
@@ -94,7 +130,7 @@ impl Painter for BarPainter<'_> {
         let base = self.base.max(0.0).max(chart.y_range().start);
         let pixels = chart.backend_coord(&(width, base)).0 - chart.backend_coord(&(0.0, base)).0;
         let label = TextStyle::from((FONT, 11)).pos(Pos::new(HPos::Center, VPos::Bottom));
-        for (j, (name, values)) in self.bars.series.iter().zip(self.values).enumerate() {
+        for (j, ((name, values), labels)) in self.bars.series.iter().zip(self.values).zip(self.labels).enumerate() {
             let color = self.colors.of(name);
             for (i, value) in values.iter().enumerate() {
                 let Some(y) = *value else { continue };
@@ -102,8 +138,12 @@ impl Painter for BarPainter<'_> {
                 chart
                     .draw_series(std::iter::once(Rectangle::new([(left, base), (left + width, y)], color.filled())))?;
                 if pixels >= MIN_LABELLED_BAR {
-                    let top =
-                        EmptyElement::at((left + width / 2.0, y)) + Text::new(axes::number(y), (0, -3), label.clone());
+                    let text = match labels[i].parse::<f64>() {
+                        Ok(v) => axes::number(v),
+                        Err(_) if labels[i].is_empty() => axes::number(y),
+                        Err(_) => labels[i].clone(),
+                    };
+                    let top = EmptyElement::at((left + width / 2.0, y)) + Text::new(text, (0, -3), label.clone());
                     chart.draw_series(std::iter::once(top))?;
                 }
             }

@@ -9,6 +9,7 @@ use csv::StringRecord;
 use crate::error::{Error, Result};
 use crate::experiment::row::METRICS;
 use crate::experiment::spec::{Figure, FigureKind};
+use crate::mesh::source::AnimationSource;
 
 /// A results CSV in memory: its header and its records as text.
 pub struct Table {
@@ -30,6 +31,25 @@ pub struct Panel {
 pub struct Series {
     pub name: String,
     pub points: Vec<(String, f64)>,
+    /// Per point, the figure's `label` cell (empty without one, or where the row has none).
+    pub labels: Vec<String>,
+}
+
+/// The keys of an animated model (`PATH#clip=NAME,frames=N,subdiv=L`) a figure may read as
+/// `source:KEY`.
+pub const SOURCE_KEYS: &[&str] = &["clip", "frames", "subdiv"];
+
+/// The value of `key` in the animated model `model`, defaults written out (clip `all`, subdiv
+/// `0`); `None` for a static model, a key the model leaves to its keyframes (`frames`), or an
+/// unknown key.
+pub fn source_key(model: &str, key: &str) -> Option<String> {
+    let source = AnimationSource::parse(model)?.ok()?;
+    match key {
+        "clip" => Some(source.selection.clip.unwrap_or_else(|| "all".to_string())),
+        "frames" => source.selection.frames.map(|n| n.to_string()),
+        "subdiv" => Some(source.subdiv.to_string()),
+        _ => None,
+    }
 }
 
 impl Table {
@@ -100,11 +120,15 @@ impl Table {
     }
 
     /// Where a figure reads a column `name`: a CSV column; `param:NAME`, a parameter of the method
-    /// (read from its canonical spec); or, for x only, `metric:NAME`, the value of that metric for
-    /// the same model and method (so one metric can be plotted against another).
+    /// (read from its canonical spec); `source:KEY`, a key of the animated model; or, for x and
+    /// bar labels only, `metric:NAME`, the value of that metric for the same model and method (so
+    /// one metric can be plotted against, or written on, another).
     fn resolve(&self, name: &str) -> Result<Column> {
         if let Some(param) = name.strip_prefix("param:") {
             return Ok(Column::Param(self.column("method")?, param.to_string()));
+        }
+        if let Some(key) = name.strip_prefix("source:") {
+            return Ok(Column::Source(self.column("model")?, key.to_string()));
         }
         let Some(metric) = name.strip_prefix("metric:") else {
             return Ok(Column::Plain(self.column(name)?));
@@ -139,6 +163,7 @@ impl Table {
         let series = self.resolve(&figure.series)?;
         let facet = figure.facet.as_deref().map(|f| self.resolve(f)).transpose()?;
         let x = figure.x.as_deref().map(|x| self.resolve(x)).transpose()?;
+        let label = figure.label.as_deref().map(|l| self.resolve(l)).transpose()?;
         let filter = figure
             .filter
             .iter()
@@ -159,9 +184,8 @@ impl Table {
                 Error::input(self.path.display(), format!("line {line}: value `{}` is not a number", &record[value]))
             })?;
             let x = x.as_ref().map_or(String::new(), |c| c.cell(record));
-            if x.is_empty() && figure.x.as_deref().is_some_and(|c| c.starts_with("metric:") || c.starts_with("param:"))
-            {
-                continue; // a method without that parameter, or not measured by the x metric
+            if x.is_empty() && figure.x.as_deref().is_some_and(|c| c.contains(':')) {
+                continue; // a method without that parameter, a static model, or not measured by the x metric
             }
             let title = match (&facet, triangles) {
                 (None, _) => String::new(),
@@ -179,7 +203,7 @@ impl Table {
             let series = match panel.series.iter().position(|s| s.name == name) {
                 Some(s) => &mut panel.series[s],
                 None => {
-                    panel.series.push(Series { name: name.clone(), points: Vec::new() });
+                    panel.series.push(Series { name: name.clone(), points: Vec::new(), labels: Vec::new() });
                     panel.series.last_mut().expect("just pushed")
                 }
             };
@@ -196,6 +220,7 @@ impl Table {
                 ));
             }
             series.points.push((x, y));
+            series.labels.push(label.as_ref().map_or(String::new(), |l| l.cell(record)));
         }
         if panels.is_empty() {
             let mut metrics: Vec<&str> = self.records.iter().map(|r| &r[metric]).collect();
@@ -220,6 +245,8 @@ enum Column {
     Plain(usize),
     /// The method column and the parameter's name.
     Param(usize, String),
+    /// The model column and the animation key.
+    Source(usize, String),
     /// Another metric's value per (model, method): the model and method columns and the values.
     Metric {
         model: usize,
@@ -233,6 +260,7 @@ impl Column {
         match self {
             Column::Plain(i) => record[*i].to_string(),
             Column::Param(method, name) => parameter(&record[*method], name).unwrap_or_default().to_string(),
+            Column::Source(model, key) => source_key(&record[*model], key).unwrap_or_default(),
             Column::Metric { model, method, values } => values
                 .iter()
                 .find(|((m, s), _)| m == &record[*model] && s == &record[*method])
@@ -240,11 +268,13 @@ impl Column {
         }
     }
 
-    /// The cell as a legend or panel title shows it: metric names become their labels.
+    /// The cell as a legend or panel title shows it: metric names become their labels, and an
+    /// animation key is written `KEY=VALUE` (a bare `1` says nothing about what it counts).
     fn label(&self, record: &StringRecord) -> String {
         let cell = self.cell(record);
-        match METRICS.iter().find(|m| m.name == cell) {
-            Some(m) if matches!(self, Column::Plain(_)) => m.label.to_string(),
+        match (self, METRICS.iter().find(|m| m.name == cell)) {
+            (Column::Plain(_), Some(m)) => m.label.to_string(),
+            (Column::Source(_, key), _) if !cell.is_empty() => format!("{key}={cell}"),
             _ => cell,
         }
     }
@@ -269,4 +299,20 @@ fn thousands(digits: &str) -> String {
         out.push(c);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn source_keys_read_the_animation_with_defaults() {
+        let model = "animated/Soldier.glb#clip=Run,subdiv=2";
+        assert_eq!(source_key(model, "clip").as_deref(), Some("Run"));
+        assert_eq!(source_key(model, "subdiv").as_deref(), Some("2"));
+        assert_eq!(source_key(model, "frames"), None);
+        assert_eq!(source_key("animated/Soldier.glb#frames=10", "clip").as_deref(), Some("all"));
+        assert_eq!(source_key("animated/Soldier.glb#frames=10", "subdiv").as_deref(), Some("0"));
+        assert_eq!(source_key("models/bunny.ply", "clip"), None);
+    }
 }

@@ -211,6 +211,9 @@ fn column_label(column: &str) -> &str {
     }
 }
 
+/// Widest panel that is drawn beside another.
+const MAX_SIDE_BY_SIDE_W: usize = 1000;
+
 /// Draws the whole figure into `svg`; `setup` (how the data was measured) goes under the title.
 fn draw(
     svg: &mut String,
@@ -222,9 +225,12 @@ fn draw(
     colors: &Colors,
 ) -> DrawResult {
     let n = panels.len();
-    let cols = match n {
-        1 => 1,
-        2 | 4 => 2,
+    // Panels wider than a screen's half (tables with many columns) stack, so the figure stays
+    // readable at page width.
+    let cols = match (n, kind.panel_size()) {
+        (1, _) => 1,
+        (_, Some((w, _))) if w > MAX_SIDE_BY_SIDE_W => 1,
+        (2 | 4, _) => 2,
         _ => 3,
     };
     let rows = n.div_ceil(cols);

@@ -12,19 +12,30 @@ use super::{Extent, Kind, XAxis};
 
 /// Pixel sizes of the grid.
 const ROW_H: i32 = 24;
-const HEAD_H: i32 = 64;
-const FIRST_COL_W: i32 = 230;
-const COL_W: i32 = 104;
+/// Height of the column headings above their lines of text (`LINE_H` each).
+const HEAD_BASE_H: i32 = 36;
+const LINE_H: i32 = 14;
+const FIRST_COL_W: i32 = 280;
+const COL_W: i32 = 124;
 
 /// The same values as a bar chart holds (panel × series × category), drawn as text.
 pub struct Tables(pub Bars);
+
+impl Tables {
+    /// Each column's heading lines (see [`heading`]) and the headings' height.
+    fn headings(&self) -> (Vec<Vec<String>>, i32) {
+        let headings: Vec<Vec<String>> = self.0.series.iter().map(|name| heading(name, &self.0.series)).collect();
+        let lines = headings.iter().map(Vec::len).max().unwrap_or(1).max(2);
+        (headings, HEAD_BASE_H + LINE_H * lines as i32)
+    }
+}
 
 impl Kind for Tables {
     /// The size that fits the table.
     fn panel_size(&self) -> Option<(usize, usize)> {
         let bars = &self.0;
         let w = FIRST_COL_W + COL_W * bars.series.len() as i32 + 20;
-        let h = HEAD_H + ROW_H * bars.categories.len() as i32 + 40;
+        let h = self.headings().1 + ROW_H * bars.categories.len() as i32 + 40;
         Some((w.max(400) as usize, h as usize))
     }
 
@@ -48,20 +59,19 @@ impl Kind for Tables {
             area.draw_text(title, &TextStyle::from((FONT, 15).into_font().style(FontStyle::Bold)), (10, y))?;
             y += 24;
         }
+        let (headings, head_h) = self.headings();
         let head = TextStyle::from((FONT, 12).into_font().style(FontStyle::Bold)).pos(Pos::new(HPos::Right, VPos::Top));
         for (j, name) in bars.series.iter().enumerate() {
             let x = FIRST_COL_W + COL_W * (j as i32 + 1) - 6;
             area.draw(&Rectangle::new(
-                [(x - COL_W + 10, y + HEAD_H - 30), (x, y + HEAD_H - 27)],
+                [(x - COL_W + 10, y + head_h - 30), (x, y + head_h - 27)],
                 colors.of(name).filled(),
             ))?;
-            // A method spec on two lines: the name, then its parameters.
-            let (first, rest) = name.split_once(':').unwrap_or((name, ""));
-            for (k, line) in [first, rest].iter().enumerate() {
-                area.draw_text(&truncate(line, 14), &head, (x, y + 4 + 14 * k as i32))?;
+            for (k, line) in headings[j].iter().enumerate() {
+                area.draw_text(&truncate(line, 17), &head, (x, y + 4 + LINE_H * k as i32))?;
             }
         }
-        y += HEAD_H - 20;
+        y += head_h - 20;
         let rule = |y: i32| {
             let right = FIRST_COL_W + COL_W * bars.series.len() as i32;
             area.draw(&PathElement::new(vec![(6, y), (right, y)], BLACK.stroke_width(1)))
@@ -80,7 +90,7 @@ impl Kind for Tables {
                     RGBColor(0xf2, 0xf2, 0xf2).filled(),
                 ))?;
             }
-            area.draw_text(&truncate(category, 32), &label, (10, mid))?;
+            area.draw_text(&truncate(category, 42), &label, (10, mid))?;
             let row: Vec<Option<f64>> = values.iter().map(|s| s[i]).collect();
             let best = row.iter().flatten().copied().fold(f64::INFINITY, f64::min);
             for (j, value) in row.iter().enumerate() {
@@ -96,4 +106,36 @@ impl Kind for Tables {
 /// `text` cut to `max` characters with an ellipsis.
 fn truncate(text: &str, max: usize) -> String {
     if text.chars().count() <= max { text.to_string() } else { text.chars().take(max - 1).chain(['…']).collect() }
+}
+
+/// A column heading, one line each: the method name, then the parameters that tell the column
+/// apart from the other columns of the same method (all of a canonical spec's parameters would
+/// not fit, and those the columns share say nothing). A name that is not a method spec is one line.
+fn heading(name: &str, series: &[String]) -> Vec<String> {
+    let Some((method, params)) = name.split_once(':') else {
+        return vec![name.to_string()];
+    };
+    let others: Vec<&str> = series
+        .iter()
+        .filter(|s| s.as_str() != name)
+        .filter_map(|s| s.strip_prefix(method)?.strip_prefix(':'))
+        .collect();
+    let varies = |kv: &&str| others.iter().any(|o| !o.split(',').any(|x| x == *kv));
+    std::iter::once(method).chain(params.split(',').filter(varies)).map(str::to_string).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn headings_keep_only_the_parameters_that_differ() {
+        let series: Vec<String> =
+            ["hs17:lambda=0.85,mode=single,seed=0", "hs17:lambda=3,mode=single,seed=0", "tipsify:cache=16", "model"]
+                .map(String::from)
+                .to_vec();
+        assert_eq!(heading(&series[0], &series), ["hs17", "lambda=0.85"]);
+        assert_eq!(heading(&series[2], &series), ["tipsify"]);
+        assert_eq!(heading(&series[3], &series), ["model"]);
+    }
 }

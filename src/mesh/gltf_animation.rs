@@ -66,6 +66,38 @@ pub fn read_animated(path: &Path, selection: &ClipSelection) -> Result<Animated>
     read_with_rest_pose(path, selection).map(|(animated, _)| animated)
 }
 
+/// Checks that `path` is a glTF/GLB file with the clip `selection` asks for, reading the document
+/// but posing nothing: so a run refuses a misspelt clip before any work.
+pub fn check_selection(path: &Path, selection: &ClipSelection) -> Result<()> {
+    let origin = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| Error::input(&origin, format!("cannot read: {e}")))?;
+    let binary = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let (document, _) = gltf::open(&bytes, &origin, path.parent(), binary)?;
+    choose_clips(&clip_names(&document), selection).map(drop).map_err(|problem| Error::input(&origin, problem))
+}
+
+/// Every animation's name, an unnamed one called `animation_I` (I its index in the file).
+fn clip_names(document: &::gltf::Document) -> Vec<String> {
+    document.animations().map(|a| a.name().map_or_else(|| format!("animation_{}", a.index()), str::to_string)).collect()
+}
+
+/// The indices of the clips `selection` keeps, or why there are none.
+fn choose_clips(names: &[String], selection: &ClipSelection) -> std::result::Result<Vec<usize>, String> {
+    if names.is_empty() {
+        return Err("no animation clips: the file has no animations".into());
+    }
+    match &selection.clip {
+        None => Ok((0..names.len()).collect()),
+        Some(wanted) => {
+            let chosen: Vec<usize> = (0..names.len()).filter(|&a| &names[a] == wanted).collect();
+            if chosen.is_empty() {
+                return Err(format!("no animation clip named '{wanted}'; the clips are: {}", names.join(", ")));
+            }
+            Ok(chosen)
+        }
+    }
+}
+
 /// Reads `path` as [`read_animated`] does, with the pose the file shows when no animation plays
 /// (every node at its own transform, morph weights at their defaults): posed by it, a file
 /// without morph targets gives the positions [`gltf::read`] gives.
@@ -111,23 +143,8 @@ pub fn read_with_rest_pose(path: &Path, selection: &ClipSelection) -> Result<(An
     let mesh = Mesh::new(origin.as_str(), positions, triangles, attributes)?;
     let rest = rig.pose(0.0, &rest_world);
 
-    let names: Vec<String> = document
-        .animations()
-        .map(|a| a.name().map_or_else(|| format!("animation_{}", a.index()), str::to_string))
-        .collect();
-    if names.is_empty() {
-        return Err(fail("no animation clips: the file has no animations".into()));
-    }
-    let chosen: Vec<usize> = match &selection.clip {
-        None => (0..names.len()).collect(),
-        Some(wanted) => {
-            let chosen: Vec<usize> = (0..names.len()).filter(|&a| &names[a] == wanted).collect();
-            if chosen.is_empty() {
-                return Err(fail(format!("no animation clip named '{wanted}'; the clips are: {}", names.join(", "))));
-            }
-            chosen
-        }
-    };
+    let chosen = choose_clips(&clip_names(&document), selection).map_err(fail)?;
+    let names = clip_names(&document);
     let animations: Vec<::gltf::Animation<'_>> = document.animations().collect();
     let mut clips = Vec::with_capacity(chosen.len());
     for a in chosen {

@@ -43,10 +43,12 @@ pub fn open(source: &str, data: Option<&Path>, seed: u64) -> Result<Mesh> {
 }
 
 /// Checks that `source` can be opened, without reading or generating it: a well-formed
-/// procedural spec, or a file that exists. Lets a long run fail before any work.
+/// procedural spec, a file that exists, or an animation whose file has the clip it names (read,
+/// not posed). Lets a long run fail before any work.
 pub fn check(source: &str, data: Option<&Path>) -> Result<()> {
     if let Some(animation) = AnimationSource::parse(source) {
-        return locate_file(&animation?.path, data).map(drop);
+        let animation = animation?;
+        return gltf_animation::check_selection(&locate_file(&animation.path, data)?, &animation.selection);
     }
     if let Some((base, count)) = simplify::parse_source(source) {
         simplify::parse_target(source, count)?;
