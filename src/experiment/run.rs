@@ -6,8 +6,8 @@
 //! measured over its keyframes with the index buffers it picks per (keyframe, view) (Han & Sander
 //! 2017, §4); so is a static model, as one frame, when a method of the spec gives several buffers,
 //! so that all methods on it are measured the same way. Orderings run one after another so their
-//! wall times are honest; only the rasterizer runs in parallel, inside one measurement. The CSV is written atomically at the end:
-//! an interrupted run leaves the previous results untouched.
+//! wall times are honest; only the rasterizer runs in parallel, inside one measurement. The CSV is
+//! written atomically at the end: an interrupted run leaves the previous results untouched.
 
 use std::path::{Path, PathBuf};
 

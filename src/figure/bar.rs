@@ -64,8 +64,12 @@ impl Bars {
 }
 
 impl Kind for Bars {
-    fn extent(&self) -> Extent {
-        let all = self.values.iter().flatten().flatten().flatten().copied();
+    fn extent(&self, panel: Option<usize>) -> Extent {
+        let panels = match panel {
+            Some(i) => &self.values[i..=i],
+            None => &self.values[..],
+        };
+        let all = panels.iter().flatten().flatten().flatten().copied();
         Extent {
             x: XAxis::Categories(self.categories.clone()),
             y: super::span(all).unwrap_or((0.0, 1.0)),

@@ -51,8 +51,12 @@ impl Distribution {
 }
 
 impl Kind for Distribution {
-    fn extent(&self) -> Extent {
-        let all = self.panels.iter().flatten().flat_map(|s| s.values.iter().copied());
+    fn extent(&self, panel: Option<usize>) -> Extent {
+        let panels = match panel {
+            Some(i) => &self.panels[i..=i],
+            None => &self.panels[..],
+        };
+        let all = panels.iter().flatten().flat_map(|s| s.values.iter().copied());
         Extent { x: XAxis::Fixed(0.0..100.0), y: super::span(all).unwrap_or((0.0, 1.0)), from_zero: false }
     }
 

@@ -78,7 +78,14 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
         | FigureKind::ClusterOrder
         | FigureKind::Overdraw => return drawing::plot(spec, opts, &table),
     };
-    let frame = frame(kind.as_ref(), figure, &csv)?;
+    // Panels share their axes, except panels of different metrics, whose units differ.
+    let frames = if figure.facet.as_deref() == Some("metric") {
+        (0..panels.len())
+            .map(|i| frame(kind.as_ref(), figure, &csv, Some((i, &panels[i].title))))
+            .collect::<Result<Vec<_>>>()?
+    } else {
+        vec![frame(kind.as_ref(), figure, &csv, None)?]
+    };
     let mut names: Vec<String> = Vec::new();
     for s in panels.iter().flat_map(|p| &p.series) {
         if !names.contains(&s.name) {
@@ -89,7 +96,7 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
 
     let path = spec.svg_path(&opts.out_dir, opts.quick);
     let mut svg = String::new();
-    draw(&mut svg, spec, &setup.join(" · "), &panels, kind.as_ref(), &frame, &colors)
+    draw(&mut svg, spec, &setup.join(" · "), &panels, kind.as_ref(), &frames, &colors)
         .map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| Error::output(&path, e))?;
@@ -100,8 +107,8 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
 
 /// A chart kind: its data, prepared from the panels, and how one panel of it is drawn.
 trait Kind {
-    /// The extent of the data over all panels (panels share axes).
-    fn extent(&self) -> Extent;
+    /// The extent of the data of one panel, or (`None`) of all panels, for axes they share.
+    fn extent(&self, panel: Option<usize>) -> Extent;
     fn swatch(&self) -> Swatch;
     /// Whether the figure needs a colour legend (tables name their columns themselves).
     fn legend(&self) -> bool {
@@ -141,10 +148,11 @@ fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     })
 }
 
-/// The shared axes: data extent padded by 5% (multiplicatively on log axes), the spec's y range
-/// if it gives one, and the axis titles.
-fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path) -> Result<Frame> {
-    let extent = kind.extent();
+/// The axes: data extent padded by 5% (multiplicatively on log axes), the spec's y range if it
+/// gives one, and the axis titles. For all panels, or for the one panel `(index, title)` alone
+/// (its y axis then titled by the panel).
+fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &str)>) -> Result<Frame> {
+    let extent = kind.extent(panel.map(|(i, _)| i));
     let log_error = |key: &str, lo: f64| {
         Error::input(csv.display(), format!("figure.{key} asks for a log axis, but the data has a value {lo} ≤ 0"))
     };
@@ -182,7 +190,10 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path) -> Result<Frame> {
         x_log: figure.x_log,
         y_log: figure.y_log,
         x_desc,
-        y_desc: figure.y_label.clone().unwrap_or(metric),
+        y_desc: match panel {
+            Some((_, title)) => title.to_string(),
+            None => figure.y_label.clone().unwrap_or(metric),
+        },
         categories,
     })
 }
@@ -221,7 +232,7 @@ fn draw(
     setup: &str,
     panels: &[Panel],
     kind: &dyn Kind,
-    frame: &Frame,
+    frames: &[Frame],
     colors: &Colors,
 ) -> DrawResult {
     let n = panels.len();
@@ -246,7 +257,7 @@ fn draw(
     let (body, legend) = rest.split_vertically((rows * panel_h) as u32);
     header.draw(&top)?;
     for (i, (area, panel)) in body.split_evenly((rows, cols)).iter().zip(panels).enumerate() {
-        kind.draw(i, area, &panel.title, frame, colors)?;
+        kind.draw(i, area, &panel.title, &frames[i.min(frames.len() - 1)], colors)?;
     }
     if kind.legend() {
         axes::legend(&legend, colors.entries(), kind.swatch())?;

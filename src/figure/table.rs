@@ -39,7 +39,7 @@ impl Kind for Tables {
         Some((w.max(400) as usize, h as usize))
     }
 
-    fn extent(&self) -> Extent {
+    fn extent(&self, _: Option<usize>) -> Extent {
         Extent { x: XAxis::Categories(self.0.categories.clone()), y: (0.0, 1.0), from_zero: true }
     }
 

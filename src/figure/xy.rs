@@ -54,15 +54,20 @@ impl Xy {
         Ok(Xy { panels, lines })
     }
 
-    fn points(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
-        self.panels.iter().flatten().flat_map(|(_, p)| p.iter().copied())
+    /// The points of panel `panel`, or of every panel.
+    fn points(&self, panel: Option<usize>) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let panels = match panel {
+            Some(i) => &self.panels[i..=i],
+            None => &self.panels[..],
+        };
+        panels.iter().flatten().flat_map(|(_, p)| p.iter().copied())
     }
 }
 
 impl Kind for Xy {
-    fn extent(&self) -> Extent {
-        let (x, y) = super::span(self.points().map(|p| p.0))
-            .zip(super::span(self.points().map(|p| p.1)))
+    fn extent(&self, panel: Option<usize>) -> Extent {
+        let (x, y) = super::span(self.points(panel).map(|p| p.0))
+            .zip(super::span(self.points(panel).map(|p| p.1)))
             .unwrap_or(((0.0, 1.0), (0.0, 1.0)));
         Extent { x: XAxis::Data(x.0, x.1), y, from_zero: false }
     }
