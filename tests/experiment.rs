@@ -83,7 +83,8 @@ fn repository_specs_parse() {
     }
     let acmr = Spec::load(&dir.join("universal-acmr-vs-cache.toml")).unwrap();
     assert_eq!(acmr.methods.len(), order::METHODS.len());
-    assert_eq!(acmr.full.caches.len(), 17);
+    assert_eq!(acmr.full.caches.len(), 11);
+    assert_eq!(acmr.full.caches[10], CacheModel::Fifo(64));
     assert_eq!(acmr.full.caches[0], CacheModel::Fifo(4));
     assert_eq!(acmr.quick.as_ref().unwrap().caches.len(), 16);
     let ovr = Spec::load(&dir.join("ovr-distribution-bunny.toml")).unwrap();
