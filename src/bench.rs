@@ -87,6 +87,39 @@ pub fn median_interleaved<const N: usize>(reps: usize, mut fs: [&mut dyn FnMut()
     })
 }
 
+/// One timing of the two raster backends on the same work.
+#[derive(Debug, Clone)]
+pub struct BackendRow {
+    pub mesh: String,
+    pub triangles: usize,
+    pub views: ViewSet,
+    pub res: u32,
+    pub cpu_seconds: f64,
+    pub gpu_seconds: f64,
+    /// The GPU backend as written into results (device and driver).
+    pub device: String,
+}
+
+/// Times overdraw counting of `mesh` (in meshoptimizer's vertex-cache order) over `views` at
+/// `res` on the CPU reference and on `gpu`, taking turns. The GPU time includes what a caller
+/// pays: uploading the mesh, drawing, reading the counts back.
+pub fn compare_backends(mesh: &Mesh, gpu: &dyn RasterBackend, views: ViewSet, res: u32, reps: usize) -> BackendRow {
+    let indices = meshopt::optimize_vertex_cache(&peer::index_buffer(mesh), mesh.vertex_count());
+    let triangles: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let cameras = views.cameras(Framing::of(&mesh.positions), 0);
+    let run = |backend: &dyn RasterBackend| black_box(backend.count(&mesh.positions, &triangles, &cameras, res).ok());
+    let [cpu_seconds, gpu_seconds] = median_interleaved(reps, [&mut || drop(run(&CpuRaster)), &mut || drop(run(gpu))]);
+    BackendRow {
+        mesh: mesh.name.clone(),
+        triangles: mesh.triangle_count(),
+        views,
+        res,
+        cpu_seconds,
+        gpu_seconds,
+        device: gpu.describe(),
+    }
+}
+
 /// Times every comparison on `mesh`, drawn in meshoptimizer's vertex-cache order (the realistic
 /// case: an optimised mesh being analysed).
 pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {

@@ -25,6 +25,10 @@ pub enum Error {
     /// An experiment spec that is malformed or inconsistent.
     #[error("{path}: {problem}")]
     Spec { path: String, problem: String },
+    /// The GPU could not be opened or failed while measuring: no adapter, a lost device, a mesh or
+    /// image over the device's limits. The message says what to do.
+    #[error("GPU: {0}")]
+    Gpu(String),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -3,7 +3,8 @@
 
 use std::time::Instant;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::gpu::vertex_reuse;
 use crate::mesh::Mesh;
 use crate::mesh::keyframes::Keyframes;
 use crate::metrics::{CacheModel, CacheStats, OverdrawSummary, cache};
@@ -15,11 +16,26 @@ use crate::topology::Topology;
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasureOptions {
     pub caches: Vec<CacheModel>,
+    /// Also count vertex-shader invocations on the GPU (the cache entry [`GPU_CACHE`]).
+    pub gpu_vertices: bool,
     /// Overdraw is measured only when a view set is given (it costs far more than the caches).
     pub views: Option<ViewSet>,
     pub res: u32,
     /// Seeds `random:N` view sets.
     pub seed: u64,
+}
+
+/// The cache entry, in `--cache` and a spec's `caches`, that counts the GPU's own vertex reuse
+/// instead of simulating a model.
+pub const GPU_CACHE: &str = "gpu";
+
+/// Vertex reuse counted on a GPU.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GpuVertices {
+    /// The device and driver that counted.
+    pub device: String,
+    /// Misses are vertex-shader invocations.
+    pub stats: CacheStats,
 }
 
 /// Overdraw of one order over a view set.
@@ -36,6 +52,7 @@ pub struct Overdraw {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
     pub caches: Vec<(CacheModel, CacheStats)>,
+    pub gpu_vertices: Option<GpuVertices>,
     pub overdraw: Option<Overdraw>,
 }
 
@@ -49,6 +66,13 @@ pub fn measure(
     let triangles = mesh.triangles_in_order(order);
     let caches =
         options.caches.iter().map(|&model| (model, cache::simulate(model, &triangles, mesh.vertex_count()))).collect();
+    let gpu_vertices = match options.gpu_vertices {
+        false => None,
+        true => {
+            let counter = vertex_reuse::shared()?;
+            Some(GpuVertices { device: counter.device(), stats: counter.count(&mesh.positions, &triangles)? })
+        }
+    };
     let overdraw = match options.views {
         None => None,
         Some(views) => {
@@ -58,7 +82,7 @@ pub fn measure(
             Some(Overdraw { views, res: options.res, per_view, summary })
         }
     };
-    Ok(Measurement { caches, overdraw })
+    Ok(Measurement { caches, gpu_vertices, overdraw })
 }
 
 /// One method's result on one mesh.
@@ -126,6 +150,11 @@ pub fn measure_nodes(
     options: &MeasureOptions,
     raster: &dyn RasterBackend,
 ) -> Result<NodeMeasurement> {
+    if options.gpu_vertices {
+        return Err(Error::usage(format!(
+            "the `{GPU_CACHE}` cache counts one index buffer on the GPU: measure a static mesh with a static method"
+        )));
+    }
     let mut uses = vec![0u64; nodes.buffers.len()];
     let mut overdraw = Vec::new();
     if let Some(views) = options.views {

@@ -11,6 +11,7 @@ pub mod error;
 pub mod eval;
 pub mod experiment;
 pub mod figure;
+pub mod gpu;
 pub mod mesh;
 
 pub use error::{Error, Result};

@@ -32,8 +32,9 @@ struct Common {
 /// What to measure, as in `eval` and `order`.
 #[derive(Args, Clone)]
 struct Measure {
-    /// Vertex-cache model(s): fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP. Repeatable; the first
-    /// is the one summarised. Default fifo:16.
+    /// Vertex-cache model(s): fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP, or `gpu` to count
+    /// vertex-shader invocations on the GPU (pipeline statistics). Repeatable; the first model is
+    /// the one summarised. Default fifo:16.
     #[arg(long = "cache", value_name = "MODEL")]
     caches: Vec<String>,
     /// Measure overdraw over a view set: axis6, ico:N (12, 42, 162, 642, 2562) or random:N.
@@ -42,8 +43,9 @@ struct Measure {
     /// Image side in pixels for overdraw.
     #[arg(long, default_value_t = 512)]
     res: u32,
-    /// Raster backend for overdraw.
-    #[arg(long, default_value = "cpu")]
+    /// Raster backend for overdraw: cpu (the reference rasterizer) or gpu (Vulkan through wgpu;
+    /// Mesa's lavapipe will do where there is no GPU).
+    #[arg(long, default_value = "cpu", value_name = "cpu|gpu")]
     backend: String,
 }
 
@@ -64,11 +66,15 @@ struct Animation {
     subdiv: Option<u32>,
 }
 
-/// The two halves of `bench`.
+/// The parts of `bench`.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum BenchPart {
+    /// Our cache simulators and overdraw counter vs meshoptimizer's analyzers.
     Metrics,
+    /// Our orderings vs their meshoptimizer peers.
     Orderings,
+    /// The GPU raster backend vs the CPU one (ico:162 at 512²); needs a Vulkan adapter.
+    Backends,
 }
 
 #[derive(Subcommand)]
@@ -123,6 +129,9 @@ enum Command {
         /// Small models and views (seconds); writes under results/quick/.
         #[arg(long)]
         quick: bool,
+        /// Raster backend for overdraw, overriding the spec's: cpu or gpu (Vulkan through wgpu).
+        #[arg(long, value_name = "cpu|gpu")]
+        backend: Option<String>,
         #[command(flatten)]
         common: Common,
     },
@@ -141,6 +150,9 @@ enum Command {
         /// Only the experiment with this id.
         #[arg(long, value_name = "ID")]
         only: Option<String>,
+        /// Raster backend for overdraw in every spec: cpu or gpu (Vulkan through wgpu).
+        #[arg(long, value_name = "cpu|gpu")]
+        backend: Option<String>,
         #[command(flatten)]
         common: Common,
     },
@@ -153,7 +165,7 @@ enum Command {
         /// sphere and the bundled cow when there is no data directory).
         #[arg(long = "mesh", value_name = "MESH")]
         meshes: Vec<String>,
-        /// Time only the metrics or only the orderings.
+        /// Time one part only. Without it: metrics and orderings (the backends need a GPU).
         #[arg(long, value_enum)]
         only: Option<BenchPart>,
         #[command(flatten)]
@@ -171,9 +183,11 @@ fn main() -> ExitCode {
         Command::Eval { mesh, methods, measure, animation, json, common } => {
             commands::eval(&mesh, &methods, &measure, &animation, json, &common)
         }
-        Command::Run { spec, quick, common } => commands::run(&spec, quick, &common),
+        Command::Run { spec, quick, backend, common } => commands::run(&spec, quick, backend, &common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick),
-        Command::Reproduce { quick, only, common } => commands::reproduce(quick, only.as_deref(), &common),
+        Command::Reproduce { quick, only, backend, common } => {
+            commands::reproduce(quick, only.as_deref(), backend, &common)
+        }
         Command::Bench { reps, meshes, only, common } => commands::bench(reps, &meshes, only, &common),
     };
     match result {

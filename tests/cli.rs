@@ -198,6 +198,23 @@ fn bad_values_are_named() {
 }
 
 #[test]
+fn gpu_backend_without_a_driver_says_how_to_get_one() {
+    // An ICD list that names no driver hides every Vulkan device, lavapipe included.
+    let o = Command::new(env!("CARGO_BIN_EXE_triorder"))
+        .args(["eval", "grid:4x4", "--views", "axis6", "--backend", "gpu"])
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for want in ["no GPU adapter", "mesa-vulkan-drivers", "VK_DRIVER_FILES"] {
+        assert!(err.contains(want), "lacks `{want}`: {err}");
+    }
+    assert!(fails(&["run", "experiments/nbs06-variance-table.toml", "--backend", "metal"]).contains("metal"));
+}
+
+#[test]
 fn every_broken_file_fails_cleanly() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");
     let mut checked = 0;

@@ -174,7 +174,13 @@ fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
 
     let spec = Spec::load(&spec_path).unwrap();
     let work = spec.workload(true).unwrap();
-    let options = MeasureOptions { caches: work.caches.clone(), views: work.views, res: work.res, seed: spec.seed };
+    let options = MeasureOptions {
+        gpu_vertices: false,
+        caches: work.caches.clone(),
+        views: work.views,
+        res: work.res,
+        seed: spec.seed,
+    };
     let cpu = raster::backend("cpu").unwrap();
     let mut expected_rows = 0;
     for model in &work.models {
@@ -250,7 +256,8 @@ fn per_view_rows_are_written_when_the_figure_draws_them() {
     let (_, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
     let spec = Spec::load(&path).unwrap();
     let work = spec.workload(true).unwrap();
-    let options = MeasureOptions { caches: vec![], views: work.views, res: work.res, seed: spec.seed };
+    let options =
+        MeasureOptions { gpu_vertices: false, caches: vec![], views: work.views, res: work.res, seed: spec.seed };
     for model in &work.models {
         let mesh = source::open(model, None, spec.seed).unwrap();
         let topology = Topology::new(&mesh);

@@ -1,13 +1,16 @@
-//! The CPU rasterizer against answers computed by hand.
+//! The rasterizers against answers computed by hand: every count is asserted for the CPU
+//! reference and, where a Vulkan adapter exists (always in CI), for the GPU backend too, which
+//! must give exactly the same counts on these scenes.
 //!
 //! Scenes are placed directly in normalised device coordinates with an identity camera, so at
 //! R = 512 one pixel is 1/256 NDC and every count below can be checked with a pencil.
 
+mod common;
+
 use glam::{Mat4, Vec3};
 use triorder::mesh::{Mesh, VertexAttributes, procedural};
 use triorder::metrics::OverdrawSummary;
-use triorder::raster::cpu::CpuRaster;
-use triorder::raster::{Camera, Framing, RasterBackend, ViewCounts, ViewSet};
+use triorder::raster::{Camera, Framing, ViewCounts, ViewSet};
 
 /// Identity camera: world = NDC (x, y in -1..1 map to the image, z in 0..1 is depth).
 fn ndc_camera() -> Camera {
@@ -27,8 +30,18 @@ fn quad_px(x0: f32, y0: f32, x1: f32, y1: f32, z: f32, out: &mut Vec<Vec3>, tris
     tris.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
 }
 
+/// Counts on every backend, which must agree; returns the (common) counts.
+fn count_views(positions: &[Vec3], tris: &[[u32; 3]], cameras: &[Camera], res: u32) -> Vec<ViewCounts> {
+    let backends = common::backends();
+    let reference = backends[0].count(positions, tris, cameras, res).unwrap();
+    for other in &backends[1..] {
+        assert_eq!(other.count(positions, tris, cameras, res).unwrap(), reference, "{} vs cpu", other.name());
+    }
+    reference
+}
+
 fn count(positions: &[Vec3], tris: &[[u32; 3]]) -> ViewCounts {
-    CpuRaster.count(positions, tris, &[ndc_camera()], 512).unwrap()[0]
+    count_views(positions, tris, &[ndc_camera()], 512)[0]
 }
 
 #[test]
@@ -86,7 +99,7 @@ fn cube() -> Mesh {
 
 fn summary(mesh: &Mesh, order: &[u32], views: &str, res: u32) -> (Vec<ViewCounts>, OverdrawSummary) {
     let cameras = views.parse::<ViewSet>().unwrap().cameras(Framing::of(&mesh.positions), 3);
-    let counts = CpuRaster.count(&mesh.positions, &mesh.triangles_in_order(order), &cameras, res).unwrap();
+    let counts = count_views(&mesh.positions, &mesh.triangles_in_order(order), &cameras, res);
     let s = OverdrawSummary::of(&counts).unwrap();
     (counts, s)
 }

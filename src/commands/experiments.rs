@@ -6,15 +6,20 @@ use triorder::Result;
 use triorder::experiment::{self, RunOptions, provenance};
 use triorder::figure::{self, PlotOptions};
 use triorder::mesh::source;
+use triorder::raster;
 
 use crate::{BenchPart, Common};
 
-fn run_options(quick: bool, common: &Common) -> RunOptions {
-    RunOptions { quick, data: common.data.clone(), progress: true, ..Default::default() }
+/// Options for `run` and `reproduce`; an unknown backend fails here, before any spec runs.
+fn run_options(quick: bool, backend: Option<String>, common: &Common) -> Result<RunOptions> {
+    if let Some(name) = &backend {
+        raster::check_backend_name(name)?;
+    }
+    Ok(RunOptions { quick, data: common.data.clone(), progress: true, backend, ..Default::default() })
 }
 
-pub fn run(spec: &Path, quick: bool, common: &Common) -> Result<()> {
-    let csv = experiment::run(spec, &run_options(quick, common))?;
+pub fn run(spec: &Path, quick: bool, backend: Option<String>, common: &Common) -> Result<()> {
+    let csv = experiment::run(spec, &run_options(quick, backend, common)?)?;
     println!("wrote {}", csv.display());
     Ok(())
 }
@@ -25,8 +30,8 @@ pub fn plot(spec: &Path, quick: bool) -> Result<()> {
     Ok(())
 }
 
-pub fn reproduce(quick: bool, only: Option<&str>, common: &Common) -> Result<()> {
-    for (csv, svg) in experiment::reproduce(&run_options(quick, common), only)? {
+pub fn reproduce(quick: bool, only: Option<&str>, backend: Option<String>, common: &Common) -> Result<()> {
+    for (csv, svg) in experiment::reproduce(&run_options(quick, backend, common)?, only)? {
         println!("wrote {} and {}", csv.display(), svg.display());
     }
     Ok(())
@@ -49,6 +54,28 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
         .collect::<Result<Vec<_>>>()?;
     println!("machine: {}", provenance::machine());
     println!("median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster)");
+    if only == Some(BenchPart::Backends) {
+        let gpu = raster::backend("gpu")?;
+        println!("\noverdraw counting, GPU backend vs CPU (ratio = GPU time / CPU time; < 1: the GPU is faster)");
+        println!(
+            "{:<28} {:>9}  {:<14} {:>10} {:>10} {:>8}  device",
+            "mesh", "triangles", "views", "cpu ms", "gpu ms", "ratio"
+        );
+        for (model, mesh) in &meshes {
+            let r = triorder::bench::compare_backends(mesh, gpu.as_ref(), raster::ViewSet::Ico(162), 512, reps);
+            println!(
+                "{:<28} {:>9}  {:<14} {:>10.1} {:>10.1} {:>7.2}x  {}",
+                model,
+                r.triangles,
+                format!("{}@{}", r.views, r.res),
+                r.cpu_seconds * 1e3,
+                r.gpu_seconds * 1e3,
+                r.gpu_seconds / r.cpu_seconds,
+                r.device
+            );
+        }
+        return Ok(());
+    }
     if only != Some(BenchPart::Orderings) {
         println!(
             "\n{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",

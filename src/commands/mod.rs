@@ -28,14 +28,16 @@ struct Measuring {
 
 impl Measuring {
     fn new(m: &Measure, seed: u64) -> Result<Measuring> {
+        let gpu_vertices = m.caches.iter().any(|c| c == eval::GPU_CACHE);
+        let simulated: Vec<&String> = m.caches.iter().filter(|c| *c != eval::GPU_CACHE).collect();
         let caches = if m.caches.is_empty() {
             vec![CacheModel::Fifo(16)]
         } else {
-            m.caches.iter().map(|c| c.parse()).collect::<Result<_>>()?
+            simulated.into_iter().map(|c| c.parse()).collect::<Result<_>>()?
         };
         let views = m.views.as_deref().map(str::parse::<ViewSet>).transpose()?;
         let raster = raster::backend(&m.backend)?;
-        Ok(Measuring { options: MeasureOptions { caches, views, res: m.res, seed }, raster })
+        Ok(Measuring { options: MeasureOptions { caches, gpu_vertices, views, res: m.res, seed }, raster })
     }
 }
 
@@ -83,7 +85,7 @@ pub fn eval(
     for method in &resolved {
         let e = eval::evaluate(&mesh, &topology, method, &measuring.options, measuring.raster.as_ref())?;
         if json {
-            println!("{}", tables::eval_json(&mesh, &e, measuring.raster.name()));
+            println!("{}", tables::eval_json(&mesh, &e, &measuring.raster.describe()));
         } else {
             table.push(&e);
         }
@@ -141,7 +143,7 @@ fn eval_nodes(
         let e =
             eval::evaluate_nodes(&mesh, &topology, &keyframes, method, &measuring.options, measuring.raster.as_ref())?;
         if json {
-            println!("{}", tables::nodes_json(&mesh, &keyframes, &e, measuring.raster.name()));
+            println!("{}", tables::nodes_json(&mesh, &keyframes, &e, &measuring.raster.describe()));
         } else {
             table.push_nodes(&e);
         }

@@ -18,6 +18,9 @@ impl EvalTable {
     pub fn new(options: &MeasureOptions) -> EvalTable {
         let mut header = vec!["method".to_string(), "seconds".to_string()];
         header.extend(options.caches.iter().map(|c| format!("ACMR/ATVR {c}")));
+        if options.gpu_vertices {
+            header.push("ACMR/ATVR counted on the GPU".into());
+        }
         if let Some(views) = options.views {
             header.push(format!("OVR mean/max/var {views}@{}", options.res));
         }
@@ -43,6 +46,9 @@ impl EvalTable {
     pub fn push(&mut self, e: &Evaluation) {
         let mut row = vec![e.method.clone(), format!("{:.4}", e.seconds)];
         row.extend(e.measurement.caches.iter().map(|(_, s)| format!("{:.4}/{:.4}", s.acmr(), s.atvr())));
+        if let Some(gpu) = &e.measurement.gpu_vertices {
+            row.push(format!("{:.4}/{:.4}", gpu.stats.acmr(), gpu.stats.atvr()));
+        }
         if let Some(o) = &e.measurement.overdraw {
             row.push(summary_cell(o.summary));
         }
@@ -83,6 +89,11 @@ pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
         .map(|(m, s)| json!({"cache": m.to_string(), "acmr": s.acmr(), "atvr": s.atvr(), "misses": s.misses}))
         .collect();
     o.insert("caches".into(), Value::Array(caches));
+    if let Some(gpu) = &e.measurement.gpu_vertices {
+        let s = &gpu.stats;
+        let counted = json!({"device": gpu.device, "acmr": s.acmr(), "atvr": s.atvr(), "invocations": s.misses});
+        o.insert("gpu_vertices".into(), counted);
+    }
     if let Some(od) = &e.measurement.overdraw {
         o.insert("views".into(), json!(od.views.to_string()));
         o.insert("res".into(), json!(od.res));

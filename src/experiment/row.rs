@@ -8,7 +8,7 @@
 
 use serde::Serialize;
 
-use crate::eval::{Evaluation, NodeEvaluation, Overdraw};
+use crate::eval::{Evaluation, GPU_CACHE, NodeEvaluation, Overdraw};
 use crate::mesh::{Mesh, simplify};
 use crate::metrics::CacheModel;
 
@@ -131,6 +131,17 @@ impl Context {
         let mut rows = Vec::new();
         for (cache, stats) in &eval.measurement.caches {
             rows.extend(cache_rows(&base, cache, stats.acmr(), stats.atvr()));
+        }
+        if let Some(gpu) = &eval.measurement.gpu_vertices {
+            // Counted, not simulated: the cache is the device, named in `backend`.
+            let counted = Row {
+                cache: Some(GPU_CACHE.into()),
+                cache_kind: Some(GPU_CACHE),
+                backend: format!("{GPU_CACHE}: {}", gpu.device),
+                ..base.clone()
+            };
+            rows.push(Row { metric: "acmr", value: gpu.stats.acmr(), ..counted.clone() });
+            rows.push(Row { metric: "atvr", value: gpu.stats.atvr(), ..counted });
         }
         if let Some(overdraw) = &eval.measurement.overdraw {
             self.overdraw_rows(&base, overdraw, &mut rows);

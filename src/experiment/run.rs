@@ -37,11 +37,13 @@ pub struct RunOptions {
     /// The project root: [`reproduce`] reads `experiments/` in it, and `results/` and
     /// `paper-figures/` are written under it.
     pub out_dir: PathBuf,
+    /// Raster backend for every spec, overriding each spec's `backend` (`cpu` or `gpu`).
+    pub backend: Option<String>,
 }
 
 impl Default for RunOptions {
     fn default() -> Self {
-        RunOptions { quick: false, data: None, progress: false, out_dir: PathBuf::from(".") }
+        RunOptions { quick: false, data: None, progress: false, out_dir: PathBuf::from("."), backend: None }
     }
 }
 
@@ -101,12 +103,18 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
         check_model(spec, &format!("{models_key}[{i}]"), model, data.as_deref())?;
     }
     let methods = spec.methods.iter().map(|m| order::resolve(m, spec.seed)).collect::<Result<Vec<_>>>()?;
-    let raster = raster::backend(&spec.backend)?;
-    let measure = MeasureOptions { caches: work.caches.clone(), views: work.views, res: work.res, seed: spec.seed };
+    let raster = raster::backend(opts.backend.as_deref().unwrap_or(&spec.backend))?;
+    let measure = MeasureOptions {
+        caches: work.caches.clone(),
+        gpu_vertices: work.gpu_vertices,
+        views: work.views,
+        res: work.res,
+        seed: spec.seed,
+    };
     let context = Context {
         experiment: spec.id.clone(),
         seed: spec.seed,
-        backend: spec.backend.clone(),
+        backend: raster.describe(),
         machine: provenance::machine(),
         commit: provenance::commit(),
         per_view: spec.figure.metrics.iter().any(|m| m == "ovr"),

@@ -24,12 +24,14 @@
 //!                                  # ["input", "meshopt-fifo:cache={8,16,32}", "random:seed={1..3}"]
 //! caches = ["fifo:4..64", "lru:16", "batch:32,32,32"]
 //!                                  # cache models; `KIND:LO..HI` is every size from LO to HI
-//!                                  # inclusive, `KIND:LO..HI/STEP` every STEP-th (fifo, lru)
+//!                                  # inclusive, `KIND:LO..HI/STEP` every STEP-th (fifo, lru);
+//!                                  # "gpu" counts vertex-shader invocations on the GPU instead
+//!                                  # (rows with cache = "gpu"; static meshes and methods only)
 //! views = "ico:162"                # optional: measure overdraw over this view set (axis6,
 //!                                  # ico:N, random:N)
 //! res = 512                        # optional, with views only: image size R×R (default 512)
 //! seed = 0                         # optional (default 0): seeds random orders, random views, disk:N
-//! backend = "cpu"                  # optional (default cpu): the raster backend
+//! backend = "cpu"                  # optional (default cpu): the raster backend, cpu or gpu
 //!
 //! [figure]
 //! kind = "line"                    # line | scatter | bar | distribution | table |
@@ -77,6 +79,7 @@ use serde::Deserialize;
 
 use super::row::{COLUMNS, METRICS, Needs};
 use crate::error::{Error, Result};
+use crate::eval::GPU_CACHE;
 use crate::mesh::source::AnimationSource;
 use crate::mesh::{procedural, simplify};
 use crate::metrics::CacheModel;
@@ -119,6 +122,8 @@ pub struct Spec {
 pub struct Workload {
     pub models: Vec<String>,
     pub caches: Vec<CacheModel>,
+    /// The caches list names [`GPU_CACHE`]: count vertex-shader invocations on the GPU too.
+    pub gpu_vertices: bool,
     pub views: Option<ViewSet>,
     pub res: u32,
 }
@@ -343,7 +348,7 @@ impl RawSpec {
         }
         let methods = check_methods(&self.methods, self.seed).map_err(err)?;
         let backend = self.backend.unwrap_or_else(|| "cpu".into());
-        raster::backend(&backend).map_err(|e| err(format!("backend: {e}")))?;
+        raster::check_backend_name(&backend).map_err(|e| err(format!("backend: {e}")))?;
 
         let full = check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res).map_err(err)?;
         let quick = match &self.quick {
@@ -362,15 +367,23 @@ impl RawSpec {
             }
         };
         let figure = self.figure.check(&full, &methods).map_err(err)?;
-        if figure.kind.draws_meshes() {
-            let per_node = methods.iter().find(|m| order::resolve(m, self.seed).is_ok_and(|r| r.method.per_node));
-            let animated = full.models.iter().chain(quick.iter().flat_map(|q| &q.models)).find(|m| is_animation(m));
-            if let Some(what) = per_node.map(|m| format!("method `{m}`")).or(animated.map(|m| format!("model `{m}`"))) {
-                return Err(err(format!(
-                    "figure.kind = \"{}\" draws one order per model and method, but {what} gives an index buffer per (keyframe, view): use a chart kind (line, bar, table, …)",
-                    kind_name(figure.kind)
-                )));
-            }
+        let per_node = methods.iter().find(|m| order::resolve(m, self.seed).is_ok_and(|r| r.method.per_node));
+        let animated = full.models.iter().chain(quick.iter().flat_map(|q| &q.models)).find(|m| is_animation(m));
+        let gpu_vertices = full.gpu_vertices || quick.as_ref().is_some_and(|q| q.gpu_vertices);
+        // What gives an index buffer per (keyframe, view), if anything does.
+        let per_node = per_node.map(|m| format!("method `{m}`")).or(animated.map(|m| format!("model `{m}`")));
+        if gpu_vertices && let Some(what) = &per_node {
+            return Err(err(format!(
+                "caches names `{GPU_CACHE}`, which counts one index buffer per model and method on the GPU, but {what} gives an index buffer per (keyframe, view)"
+            )));
+        }
+        if figure.kind.draws_meshes()
+            && let Some(what) = &per_node
+        {
+            return Err(err(format!(
+                "figure.kind = \"{}\" draws one order per model and method, but {what} gives an index buffer per (keyframe, view): use a chart kind (line, bar, table, …)",
+                kind_name(figure.kind)
+            )));
         }
         Ok(Spec {
             path: path.to_path_buf(),
@@ -452,7 +465,8 @@ fn check_workload(
         }
     }
     let mut parsed = Vec::new();
-    for (i, text) in caches.iter().enumerate() {
+    let gpu_vertices = caches.iter().any(|c| c == GPU_CACHE);
+    for (i, text) in caches.iter().enumerate().filter(|(_, c)| *c != GPU_CACHE) {
         let key = format!("{prefix}caches[{i}]");
         for model in expand_cache(text).map_err(|why| format!("{key} `{text}` {why}"))? {
             let model: CacheModel = model.parse().map_err(|e| format!("{key}: {e}"))?;
@@ -472,10 +486,10 @@ fn check_workload(
         (_, Some(r)) => r,
         (_, None) => DEFAULT_RES,
     };
-    if parsed.is_empty() && views.is_none() {
+    if parsed.is_empty() && !gpu_vertices && views.is_none() {
         return Err(format!("{prefix}caches is empty and views is not set: nothing to measure but time"));
     }
-    Ok(Workload { models: models.to_vec(), caches: parsed, views, res })
+    Ok(Workload { models: models.to_vec(), caches: parsed, gpu_vertices, views, res })
 }
 
 impl RawFigure {
@@ -491,7 +505,7 @@ impl RawFigure {
                 format!("figure.metric `{name}` is not a metric the CSV has (metrics: {})", known.join(", "))
             })?;
             match metric.needs {
-                Needs::Caches if full.caches.is_empty() => {
+                Needs::Caches if full.caches.is_empty() && !full.gpu_vertices => {
                     return Err(format!("figure.metric = \"{}\" needs `caches`", metric.name));
                 }
                 Needs::Views if full.views.is_none() => {

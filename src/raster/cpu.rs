@@ -116,6 +116,12 @@ pub fn fragments(
     Ok(())
 }
 
+/// Whether `camera` sees every vertex of `positions` without clipping and without projecting far
+/// off screen: the condition [`CpuRaster`] refuses a view for, with the same message.
+pub fn check_projection(positions: &[Vec3], camera: &Camera, res: u32) -> std::result::Result<(), String> {
+    project(positions, camera, res, &mut Vec::new())
+}
+
 /// An image side the rasterizer can draw: 1 to [`MAX_RESOLUTION`] pixels.
 fn check_resolution(res: u32) -> Result<()> {
     if (1..=MAX_RESOLUTION).contains(&res) {

@@ -1,8 +1,8 @@
-//! Fragment counting for overdraw: one trait, several backends (the CPU reference here; a wgpu
-//! backend later), all returning the same per-view counts under the same rules so they can be
-//! cross-checked.
+//! Fragment counting for overdraw: one trait, two backends (the CPU reference and a wgpu GPU
+//! backend), returning the same per-view counts under the same rules so they can be cross-checked.
 
 pub mod cpu;
+pub mod gpu;
 pub mod views;
 
 use glam::Vec3;
@@ -31,6 +31,10 @@ impl ViewCounts {
 /// Counts fragments of `triangles` (in draw order, indexing `positions`) for each camera at R×R.
 pub trait RasterBackend: Sync {
     fn name(&self) -> &'static str;
+    /// The backend as written into results: its name, and for a GPU the device and driver.
+    fn describe(&self) -> String {
+        self.name().to_string()
+    }
     fn count(
         &self,
         positions: &[Vec3],
@@ -40,10 +44,17 @@ pub trait RasterBackend: Sync {
     ) -> Result<Vec<ViewCounts>>;
 }
 
-/// The backend named `name` (`cpu`; `gpu` arrives with the wgpu backend).
+/// The backend named `name`: `cpu` (the reference) or `gpu` (opens the Vulkan device; fails with
+/// advice when there is none).
 pub fn backend(name: &str) -> Result<Box<dyn RasterBackend>> {
+    check_backend_name(name)?;
+    Ok(if name == "gpu" { Box::new(gpu::GpuRaster::new()?) } else { Box::new(cpu::CpuRaster) })
+}
+
+/// Checks a backend name without opening anything (specs are validated before any work).
+pub fn check_backend_name(name: &str) -> Result<()> {
     match name {
-        "cpu" => Ok(Box::new(cpu::CpuRaster)),
-        other => Err(crate::Error::usage(format!("unknown raster backend `{other}` (available: cpu)"))),
+        "cpu" | "gpu" => Ok(()),
+        other => Err(crate::Error::usage(format!("unknown raster backend `{other}` (available: cpu, gpu)"))),
     }
 }

@@ -35,6 +35,20 @@ pub struct Camera {
     pub perspective: bool,
 }
 
+impl Camera {
+    /// True when the sphere (`center`, `radius`) lies inside this camera's depth range and projects
+    /// well within the area the rasterizers accept (|NDC x|, |NDC y| ≤ 14), so no vertex inside it
+    /// can need clipping. Each condition is a plane a·(p, 1) ≥ 0 made from rows of the matrix.
+    pub fn frames_sphere(&self, center: Vec3, radius: f32) -> bool {
+        let m = self.view_proj;
+        let (x, y, z, w) = (m.row(0), m.row(1), m.row(2), m.row(3));
+        [z, w - z, 14.0 * w - x, 14.0 * w + x, 14.0 * w - y, 14.0 * w + y].iter().all(|plane| {
+            let normal = plane.truncate();
+            normal.dot(center) + plane.w >= radius * normal.length() * 1.0001 + f32::EPSILON
+        })
+    }
+}
+
 /// How a model is framed: bounding-box centre and the largest vertex distance from it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Framing {
@@ -253,6 +267,18 @@ mod tests {
                     assert!(ndc.x.abs() <= 1.0001 && ndc.y.abs() <= 1.0001, "{set}: {ndc}");
                     assert!(ndc.z > 0.0 && ndc.z < 1.0, "{set}: {ndc}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn framed_spheres_pass_and_clipped_ones_fail() {
+        let framing = Framing { center: Vec3::new(1.0, 2.0, 3.0), radius: 2.0 };
+        for set in ["axis6", "ico:42", "random:50"] {
+            for cam in set.parse::<ViewSet>().unwrap().cameras(framing, 7) {
+                assert!(cam.frames_sphere(framing.center, framing.radius), "{set}");
+                // Reaching the eye crosses the near plane.
+                assert!(!cam.frames_sphere(framing.center, 2.2 * framing.radius), "{set}");
             }
         }
     }

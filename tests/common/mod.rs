@@ -41,3 +41,29 @@ pub fn real_mesh(name: &str) -> Option<Mesh> {
     let path = data_dir()?.join("models").join(name);
     Some(load::load_file(&path).unwrap_or_else(|e| panic!("{e}")))
 }
+
+/// The GPU raster backend, opened once per test binary, or `None` with a notice when this machine
+/// has no Vulkan adapter. With `TRIORDER_REQUIRE_GPU` set (CI sets it, after installing Mesa's
+/// lavapipe) a missing adapter fails the test instead of skipping it.
+pub fn gpu() -> Option<&'static triorder::raster::gpu::GpuRaster> {
+    static GPU: std::sync::OnceLock<Option<triorder::raster::gpu::GpuRaster>> = std::sync::OnceLock::new();
+    GPU.get_or_init(|| match triorder::raster::gpu::GpuRaster::new() {
+        Ok(gpu) => Some(gpu),
+        Err(e) if std::env::var_os("TRIORDER_REQUIRE_GPU").is_some() => panic!("TRIORDER_REQUIRE_GPU is set: {e}"),
+        Err(e) => {
+            eprintln!("note: skipping the GPU backend: {e}");
+            None
+        }
+    })
+    .as_ref()
+}
+
+/// Every raster backend this machine can run: the CPU reference, then the GPU when there is one.
+pub fn backends() -> Vec<&'static dyn triorder::raster::RasterBackend> {
+    static CPU: triorder::raster::cpu::CpuRaster = triorder::raster::cpu::CpuRaster;
+    let mut all: Vec<&'static dyn triorder::raster::RasterBackend> = vec![&CPU];
+    if let Some(gpu) = gpu() {
+        all.push(gpu);
+    }
+    all
+}

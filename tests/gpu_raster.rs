@@ -1,0 +1,160 @@
+//! The GPU raster backend against the CPU reference on real meshes, and its failures.
+//!
+//! On the hand-made scenes of tests/overdraw.rs the two backends must agree exactly. On real
+//! meshes they may differ where the rules leave room: how a device rounds a vertex to its 1/256
+//! sub-pixel grid, and how it interpolates depth, so a fragment within a rounding error of an
+//! earlier one at the same pixel can pass on one backend and fail on the other. Every difference
+//! is counted here and must stay under 0.1% of fragments (issue 6), per view and in total.
+//!
+//! Without a Vulkan adapter these tests skip with a notice, unless TRIORDER_REQUIRE_GPU is set
+//! (CI installs Mesa's lavapipe and sets it).
+
+mod common;
+
+use triorder::mesh::{Mesh, load};
+use triorder::order::{self, OrderInput};
+use triorder::raster::cpu::CpuRaster;
+use triorder::raster::{Framing, RasterBackend, ViewSet};
+use triorder::topology::Topology;
+
+/// Sums of |gpu − cpu| over views, per count, and the CPU's total fragments.
+#[derive(Debug, Default)]
+struct Difference {
+    covered: u64,
+    fragments: u64,
+    passed: u64,
+    total_fragments: u64,
+}
+
+fn compare(name: &str, mesh: &Mesh, method: &str, views: &str, res: u32) -> Difference {
+    let gpu = common::gpu().expect("checked by the caller");
+    let topology = Topology::new(mesh);
+    let order = order::resolve(method, 1).unwrap().ordering.order(&OrderInput { mesh, topology: &topology }).unwrap();
+    let triangles = mesh.triangles_in_order(&order);
+    let cameras = views.parse::<ViewSet>().unwrap().cameras(Framing::of(&mesh.positions), 5);
+    let cpu = CpuRaster.count(&mesh.positions, &triangles, &cameras, res).unwrap();
+    let gpu_counts = gpu.count(&mesh.positions, &triangles, &cameras, res).unwrap();
+    assert_eq!(cpu.len(), gpu_counts.len());
+    let mut d = Difference::default();
+    for (i, (c, g)) in cpu.iter().zip(&gpu_counts).enumerate() {
+        let view = Difference {
+            covered: c.covered.abs_diff(g.covered),
+            fragments: c.fragments.abs_diff(g.fragments),
+            passed: c.passed.abs_diff(g.passed),
+            total_fragments: c.fragments,
+        };
+        for (what, delta) in [("covered", view.covered), ("fragments", view.fragments), ("passed", view.passed)] {
+            assert!(
+                delta * 1000 <= c.fragments.max(1000),
+                "{name} {method} {views}@{res} view {i}: {what} {c:?} vs {g:?}"
+            );
+        }
+        d.covered += view.covered;
+        d.fragments += view.fragments;
+        d.passed += view.passed;
+        d.total_fragments += c.fragments;
+    }
+    eprintln!(
+        "{name} {method} {views}@{res}: |Δ| covered {} fragments {} passed {} of {} fragments",
+        d.covered, d.fragments, d.passed, d.total_fragments
+    );
+    d
+}
+
+#[test]
+fn real_meshes_count_within_a_tenth_of_a_percent() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let mut meshes = vec![("spot".to_string(), load::load_file(std::path::Path::new("assets/spot.obj")).unwrap())];
+    for name in ["bun_zipper.ply", "horse.ply"] {
+        if let Some(mesh) = common::real_mesh(name) {
+            meshes.push((name.to_string(), mesh));
+        }
+    }
+    for (name, mesh) in &meshes {
+        for method in ["input", "random"] {
+            for (views, res) in [("ico:42", 128), ("random:20", 256)] {
+                let d = compare(name, mesh, method, views, res);
+                for delta in [d.covered, d.fragments, d.passed] {
+                    assert!(delta * 1000 <= d.total_fragments, "{name} {method}: {d:?}");
+                }
+            }
+        }
+    }
+}
+
+fn eval_json(backend: &str) -> serde_json::Value {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_triorder"))
+        .args(["eval", "assets/spot.obj", "-m", "tipsify", "--views", "ico:12", "--res", "128", "--json"])
+        .args(["--backend", backend])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    serde_json::from_str(text.lines().next().unwrap()).unwrap()
+}
+
+#[test]
+fn eval_names_the_device_and_matches_the_cpu() {
+    let Some(gpu) = common::gpu() else { return };
+    let (cpu, on_gpu) = (eval_json("cpu"), eval_json("gpu"));
+    assert_eq!(cpu["backend"], "cpu");
+    assert_eq!(on_gpu["backend"], format!("gpu: {}", gpu.device()));
+    // spot counts identically on both backends (real_meshes_count_within_a_tenth_of_a_percent).
+    for key in ["ovr_mean", "ovr_max", "ovr_var", "acmr"] {
+        assert_eq!(cpu[key], on_gpu[key], "{key}");
+    }
+}
+
+#[test]
+fn a_spec_runs_on_the_gpu_and_its_rows_name_the_device() {
+    let Some(gpu) = common::gpu() else { return };
+    let root = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(root.path().join("experiments")).unwrap();
+    let spec = root.path().join("experiments/tiny-gpu.toml");
+    std::fs::write(
+        &spec,
+        r#"id = "tiny-gpu"
+title = "GPU smoke"
+question = "Does a spec run on the GPU backend?"
+claim = "Same counts as the CPU."
+models = ["sphere:500", "layers:3"]
+methods = ["input", "random"]
+views = "axis6"
+res = 64
+[figure]
+kind = "bar"
+metric = "ovr_mean"
+x = "method"
+"#,
+    )
+    .unwrap();
+    let read = |backend: &str| {
+        let options = triorder::experiment::RunOptions {
+            out_dir: root.path().into(),
+            backend: Some(backend.into()),
+            ..Default::default()
+        };
+        let csv = triorder::experiment::run(&spec, &options).unwrap();
+        let mut reader = csv::Reader::from_path(csv).unwrap();
+        let header = reader.headers().unwrap().clone();
+        let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+        let (backend, metric, value) = (column("backend"), column("metric"), column("value"));
+        reader
+            .records()
+            .map(|r| {
+                let r = r.unwrap();
+                (r[backend].to_string(), r[metric].to_string(), r[value].to_string())
+            })
+            .collect::<Vec<_>>()
+    };
+    let (cpu, on_gpu) = (read("cpu"), read("gpu"));
+    assert!(on_gpu.iter().all(|(b, _, _)| *b == format!("gpu: {}", gpu.device())));
+    let ovr = |rows: &[(String, String, String)]| {
+        rows.iter().filter(|(_, m, _)| m.starts_with("ovr")).map(|(_, m, v)| (m.clone(), v.clone())).collect::<Vec<_>>()
+    };
+    assert!(!ovr(&cpu).is_empty());
+    assert_eq!(ovr(&cpu), ovr(&on_gpu));
+}
