@@ -212,6 +212,18 @@ fn gpu_backend_without_a_driver_says_how_to_get_one() {
         assert!(err.contains(want), "lacks `{want}`: {err}");
     }
     assert!(fails(&["run", "experiments/nbs06-variance-table.toml", "--backend", "metal"]).contains("metal"));
+    // reproduce skips a spec that needs the GPU, says why, and goes on.
+    let o = Command::new(env!("CARGO_BIN_EXE_triorder"))
+        .args(["reproduce", "--quick", "--only", "hw-vertex-reuse"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("skipping hw-vertex-reuse: it needs a GPU") && err.contains("mesa-vulkan-drivers"), "{err}");
+    assert!(stdout(&o).is_empty(), "wrote something: {}", stdout(&o));
 }
 
 #[test]

@@ -161,6 +161,16 @@ modles = ["a"]"#,
     let err =
         spec_error("tiny", &no_views.replace("res = 32\n", "").replace("metric = \"acmr\"", "metric = \"ovr_mean\""));
     assert!(err.contains("figure.metric = \"ovr_mean\" needs `views`"), "{err}");
+    // The hardware fit needs counted and simulated caches, reads ACMR, and takes no x.
+    let fit = TINY.replace("kind = \"line\"", "kind = \"hardware-fit\"").replace("x = \"cache_size\"\n", "");
+    assert!(spec_error("tiny", &fit).contains("caches must list simulated models and `gpu`"));
+    let counted = fit.replace(r#"caches = ["fifo:4..8/4", "lru:16"]"#, r#"caches = ["gpu", "fifo:4..8/4"]"#);
+    let spec = Spec::load(&write_spec(tempfile::tempdir().unwrap().path(), "tiny", &counted)).unwrap();
+    assert!(spec.full.gpu_vertices && spec.full.caches.len() == 2);
+    let with_x = counted.replace("metric = \"acmr\"", "metric = \"acmr\"\nx = \"cache_size\"");
+    assert!(spec_error("tiny", &with_x).contains("figure.x is not used by kind = \"hardware-fit\""));
+    let ovr = counted.replace("metric = \"acmr\"", "metric = \"ovr_mean\"");
+    assert!(spec_error("tiny", &ovr).contains("metric must be \"acmr\""));
 }
 
 #[test]

@@ -75,9 +75,16 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Vec<(PathBuf
         return Err(Error::usage(format!("no experiment specs{what} in {}", dir.display())));
     }
     let specs = paths.iter().map(|p| Spec::load(p)).collect::<Result<Vec<_>>>()?;
+    let mut gpu_specs = Vec::new();
     for spec in &specs {
-        spec.workload(opts.quick)?;
+        let work = spec.workload(opts.quick)?;
+        if opts.backend.is_none() && (spec.backend == "gpu" || work.gpu_vertices) {
+            gpu_specs.push(spec.id.clone());
+        }
     }
+    // Specs that ask for the GPU themselves are skipped, with a notice, where there is none, so
+    // that every CPU experiment still runs on any machine (an explicit --backend gpu must work).
+    let no_gpu = if gpu_specs.is_empty() { None } else { crate::gpu::shared().err() };
     let bars = bars(opts.progress);
     let overall = bars.add(ProgressBar::new(specs.len() as u64));
     overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));
@@ -85,6 +92,11 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Vec<(PathBuf
     let mut outputs = Vec::new();
     for spec in &specs {
         overall.set_message(spec.id.clone());
+        if let Some(why) = no_gpu.as_ref().filter(|_| gpu_specs.contains(&spec.id)) {
+            overall.suspend(|| eprintln!("skipping {}: it needs a GPU ({why})", spec.id));
+            overall.inc(1);
+            continue;
+        }
         let csv = run_spec(spec, opts, &bars)?;
         let svg = figure::plot_spec(spec, &plot)?;
         outputs.push((csv, svg));

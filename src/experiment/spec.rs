@@ -36,7 +36,8 @@
 //! [figure]
 //! kind = "line"                    # line | scatter | bar | distribution | table |
 //!                                  # sequence | corners | clusters | cluster-order | overdraw
-//!                                  # (drawings of the meshes)
+//!                                  # (drawings of the meshes) | hardware-fit (simulated cache
+//!                                  # models against the GPU's counts)
 //! metric = "acmr"                  # the y values: rows whose `metric` column is this
 //!                                  # (acmr, atvr, seconds, ovr, ovr_mean, ovr_max, ovr_min,
 //!                                  # ovr_var, ovr_sum, ovr_empty), or a list of metrics drawn
@@ -184,9 +185,19 @@ pub enum FigureKind {
     /// Each (model, method) drawn as a heat map of the fragments shaded at each pixel from the
     /// figure's view: darker, more overdraw (Nehab et al. 2006, Fig. 1).
     Overdraw,
+    /// Which simulated cache model predicts the vertex-shader invocations counted on the GPU
+    /// (caches must list simulated models and `gpu`): every model ranked by its error, and the
+    /// winner's simulated against counted ACMR (issue 6).
+    #[serde(rename = "hardware-fit")]
+    HardwareFit,
 }
 
 impl FigureKind {
+    /// Kinds whose layout is their own: they read `acmr` rows and take no x or log axes.
+    pub fn fixed_layout(self) -> bool {
+        self.draws_meshes() || self == FigureKind::HardwareFit
+    }
+
     /// Kinds that draw the meshes themselves and so need the orders saved by the run.
     pub fn draws_meshes(self) -> bool {
         matches!(
@@ -372,6 +383,12 @@ impl RawSpec {
         let gpu_vertices = full.gpu_vertices || quick.as_ref().is_some_and(|q| q.gpu_vertices);
         // What gives an index buffer per (keyframe, view), if anything does.
         let per_node = per_node.map(|m| format!("method `{m}`")).or(animated.map(|m| format!("model `{m}`")));
+        let fits = |w: &Workload| w.gpu_vertices && !w.caches.is_empty();
+        if figure.kind == FigureKind::HardwareFit && !(fits(&full) && quick.as_ref().is_none_or(fits)) {
+            return Err(err(format!(
+                "figure.kind = \"hardware-fit\" compares simulated caches with the GPU's counts: caches must list simulated models and `{GPU_CACHE}`"
+            )));
+        }
         if gpu_vertices && let Some(what) = &per_node {
             return Err(err(format!(
                 "caches names `{GPU_CACHE}`, which counts one index buffer per model and method on the GPU, but {what} gives an index buffer per (keyframe, view)"
@@ -563,17 +580,17 @@ impl RawFigure {
             }
             (_, v) => v.unwrap_or([0.0, 0.0, 1.0]),
         };
-        if self.kind.draws_meshes() && metrics != ["acmr"] {
+        if self.kind.fixed_layout() && metrics != ["acmr"] {
             return Err(format!(
-                "figure.metric = {metrics:?}: kind = \"{}\" writes each drawing's ACMR, so metric must be \"acmr\"",
+                "figure.metric = {metrics:?}: kind = \"{}\" reads ACMR, so metric must be \"acmr\"",
                 kind_name(self.kind)
             ));
         }
         match (self.kind, &self.x) {
-            (k, Some(_)) if k.draws_meshes() => {
+            (k, Some(_)) if k.fixed_layout() => {
                 return Err(format!("figure.x is not used by kind = \"{}\": remove it", kind_name(k)));
             }
-            (k, None) if k.draws_meshes() => {}
+            (k, None) if k.fixed_layout() => {}
             (FigureKind::Distribution, Some(_)) => {
                 return Err(
                     "figure.x is not used by kind = \"distribution\" (it sorts the values itself): remove it".into()
@@ -583,7 +600,7 @@ impl RawFigure {
             (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
             (k, Some(x)) => column("figure.x", x, k == FigureKind::Scatter)?,
         }
-        if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.draws_meshes()) {
+        if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.fixed_layout()) {
             return Err(format!("figure.x_log / y_log: kind = \"{}\" has no axes", kind_name(self.kind)));
         }
         if self.x_log && matches!(self.kind, FigureKind::Bar | FigureKind::Distribution) {
@@ -654,6 +671,7 @@ fn kind_name(kind: FigureKind) -> &'static str {
         FigureKind::ClusterOrder => "cluster-order",
         FigureKind::Overdraw => "overdraw",
         FigureKind::Corners => "corners",
+        FigureKind::HardwareFit => "hardware-fit",
     }
 }
 

@@ -69,6 +69,11 @@ impl Table {
         Ok(Table { path: path.to_path_buf(), header, records })
     }
 
+    /// The CSV this table was read from.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     fn column(&self, name: &str) -> Result<usize> {
         self.header.iter().position(|h| h == name).ok_or_else(|| {
             Error::input(

@@ -12,6 +12,7 @@ mod bar;
 pub(crate) mod data;
 mod distribution;
 mod drawing;
+mod hardware_fit;
 mod table;
 mod xy;
 
@@ -77,6 +78,7 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
         | FigureKind::Clusters
         | FigureKind::ClusterOrder
         | FigureKind::Overdraw => return drawing::plot(spec, opts, &table),
+        FigureKind::HardwareFit => return hardware_fit::plot(spec, opts, &table),
     };
     // Panels share their axes, except panels of different metrics, whose units differ.
     let frames = if figure.facet.as_deref() == Some("metric") {
