@@ -9,13 +9,13 @@
 #   scripts/gpu-run.sh unpack DIR      here: copy the CSVs from DIR into results/ and redraw the
 #                                      figures (they name the GPU and driver in every row)
 #
-# A GPU spec is one whose backend is "gpu" or whose caches list "gpu". The machine there cannot
+# A GPU spec is one whose backend is "gpu", whose caches list "gpu", or that renders. The machine there cannot
 # reach the network and does not see ../shared, so everything travels in .gpu-run (under 64 MiB).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 pack_dir=.gpu-run
-gpu_specs() { grep -lE '^backend *= *"gpu"|^caches *=.*"gpu"' experiments/*.toml | xargs -n1 basename | sed 's/\.toml$//'; }
+gpu_specs() { grep -lE '^backend *= *"gpu"|^caches *=.*"gpu"|^render *=' experiments/*.toml | xargs -n1 basename | sed 's/\.toml$//'; }
 
 pack() {
     local data=${TRIORDER_DATA:-../shared/data}

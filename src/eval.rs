@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use crate::error::{Error, Result};
+use crate::gpu::render_time::{self, Shading, Timing};
 use crate::gpu::vertex_reuse;
 use crate::mesh::Mesh;
 use crate::mesh::keyframes::Keyframes;
@@ -13,7 +14,7 @@ use crate::raster::{Framing, RasterBackend, ViewCounts, ViewSet};
 use crate::topology::Topology;
 
 /// What to measure.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct MeasureOptions {
     pub caches: Vec<CacheModel>,
     /// Also count vertex-shader invocations on the GPU (the cache entry [`GPU_CACHE`]).
@@ -23,6 +24,27 @@ pub struct MeasureOptions {
     pub res: u32,
     /// Seeds `random:N` view sets.
     pub seed: u64,
+    /// Also time rendering on the GPU from every view, with each of these shaders.
+    pub render: Vec<Shading>,
+    /// Timed frames per view for `render`.
+    pub render_frames: usize,
+}
+
+/// Render times of one draw order on the GPU, per view of the overdraw view set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderTime {
+    pub shading: Shading,
+    /// The device and driver that rendered.
+    pub device: String,
+    /// Median frame time per view (with its 10th and 90th percentiles).
+    pub per_view: Vec<Timing>,
+}
+
+impl RenderTime {
+    /// Mean over views of the median frame time, in milliseconds.
+    pub fn mean_ms(&self) -> f64 {
+        self.per_view.iter().map(|t| t.median_ms).sum::<f64>() / self.per_view.len().max(1) as f64
+    }
 }
 
 /// The cache entry, in `--cache` and a spec's `caches`, that counts the GPU's own vertex reuse
@@ -54,6 +76,7 @@ pub struct Measurement {
     pub caches: Vec<(CacheModel, CacheStats)>,
     pub gpu_vertices: Option<GpuVertices>,
     pub overdraw: Option<Overdraw>,
+    pub render: Vec<RenderTime>,
 }
 
 /// Measures the draw order `order` of `mesh`.
@@ -73,16 +96,30 @@ pub fn measure(
             Some(GpuVertices { device: counter.device(), stats: counter.count(&mesh.positions, &triangles)? })
         }
     };
-    let overdraw = match options.views {
-        None => None,
-        Some(views) => {
-            let cameras = views.cameras(Framing::of(&mesh.positions), options.seed);
-            let per_view = raster.count(&mesh.positions, &triangles, &cameras, options.res)?;
+    let cameras = options.views.map(|views| views.cameras(Framing::of(&mesh.positions), options.seed));
+    let overdraw = match (options.views, &cameras) {
+        (Some(views), Some(cameras)) => {
+            let per_view = raster.count(&mesh.positions, &triangles, cameras, options.res)?;
             let summary = OverdrawSummary::of(&per_view);
             Some(Overdraw { views, res: options.res, per_view, summary })
         }
+        _ => None,
     };
-    Ok(Measurement { caches, gpu_vertices, overdraw })
+    let mut render = Vec::new();
+    if !options.render.is_empty() {
+        let cameras = cameras.ok_or_else(|| Error::usage("render timing needs a view set (--views)"))?;
+        let timer = render_time::shared()?;
+        for &shading in &options.render {
+            let per_view = cameras
+                .iter()
+                .map(|camera| {
+                    timer.time(&mesh.positions, &triangles, camera, options.res, shading, options.render_frames)
+                })
+                .collect::<Result<_>>()?;
+            render.push(RenderTime { shading, device: timer.device(), per_view });
+        }
+    }
+    Ok(Measurement { caches, gpu_vertices, overdraw, render })
 }
 
 /// One method's result on one mesh.
@@ -150,9 +187,9 @@ pub fn measure_nodes(
     options: &MeasureOptions,
     raster: &dyn RasterBackend,
 ) -> Result<NodeMeasurement> {
-    if options.gpu_vertices {
+    if options.gpu_vertices || !options.render.is_empty() {
         return Err(Error::usage(format!(
-            "the `{GPU_CACHE}` cache counts one index buffer on the GPU: measure a static mesh with a static method"
+            "the `{GPU_CACHE}` cache and render timing measure one index buffer on the GPU: measure a static mesh with a static method"
         )));
     }
     let mut uses = vec![0u64; nodes.buffers.len()];

@@ -43,6 +43,13 @@ struct Measure {
     /// Image side in pixels for overdraw.
     #[arg(long, default_value_t = 512)]
     res: u32,
+    /// Time rendering on the GPU from every view of --views with this shader: pixel (procedural
+    /// texture and per-pixel lighting) or vertex (a long per-vertex loop). Repeatable.
+    #[arg(long, value_name = "pixel|vertex")]
+    render: Vec<String>,
+    /// Timed frames per view and shader for --render (their median is reported).
+    #[arg(long, default_value_t = 30, value_name = "N")]
+    render_frames: usize,
     /// Raster backend for overdraw: cpu (the reference rasterizer) or gpu (Vulkan through wgpu;
     /// Mesa's lavapipe will do where there is no GPU).
     #[arg(long, default_value = "cpu", value_name = "cpu|gpu")]

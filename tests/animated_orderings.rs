@@ -186,7 +186,7 @@ fn kmeans_reports_its_rounds_and_whether_it_converged() {
 /// Mean OVR of `nodes` drawn from `views` random cameras, each with the buffer its lookup picks.
 fn mean_ovr(scene: &Scene, nodes: &NodeOrders, views: u32, seed: u64) -> f64 {
     let options =
-        MeasureOptions { gpu_vertices: false, caches: vec![], views: Some(ViewSet::Random(views)), res: 64, seed };
+        MeasureOptions { caches: vec![], views: Some(ViewSet::Random(views)), res: 64, seed, ..Default::default() };
     let measured = measure_nodes(&scene.mesh, &scene.keyframes, nodes, &options, &CpuRaster).unwrap();
     measured.overdraw[0].overdraw.summary.expect("the views see the mesh").mean
 }

@@ -185,11 +185,11 @@ fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
     let spec = Spec::load(&spec_path).unwrap();
     let work = spec.workload(true).unwrap();
     let options = MeasureOptions {
-        gpu_vertices: false,
         caches: work.caches.clone(),
         views: work.views,
         res: work.res,
         seed: spec.seed,
+        ..Default::default()
     };
     let cpu = raster::backend("cpu").unwrap();
     let mut expected_rows = 0;
@@ -267,7 +267,7 @@ fn per_view_rows_are_written_when_the_figure_draws_them() {
     let spec = Spec::load(&path).unwrap();
     let work = spec.workload(true).unwrap();
     let options =
-        MeasureOptions { gpu_vertices: false, caches: vec![], views: work.views, res: work.res, seed: spec.seed };
+        MeasureOptions { caches: vec![], views: work.views, res: work.res, seed: spec.seed, ..Default::default() };
     for model in &work.models {
         let mesh = source::open(model, None, spec.seed).unwrap();
         let topology = Topology::new(&mesh);

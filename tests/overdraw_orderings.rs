@@ -166,7 +166,7 @@ fn sander07_overdraw_is_within_two_percent_of_meshopts() {
     use triorder::eval::{MeasureOptions, evaluate};
     use triorder::topology::Topology;
     let options =
-        MeasureOptions { gpu_vertices: false, caches: vec![], views: Some(ViewSet::Ico(162)), res: 256, seed: 0 };
+        MeasureOptions { caches: vec![], views: Some(ViewSet::Ico(162)), res: 256, seed: 0, ..Default::default() };
     let cpu = triorder::raster::backend("cpu").unwrap();
     for name in ["bunny_2k.ply", "dragon_vrip_res4.ply", "pirate.obj", "spot.obj"] {
         let Some(mesh) = common::real_mesh(name) else { return };

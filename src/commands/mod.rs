@@ -9,6 +9,7 @@ pub use experiments::{bench, plot, reproduce, run};
 use std::path::Path;
 
 use triorder::eval::{self, MeasureOptions};
+use triorder::gpu::render_time::{MAX_FRAMES, Shading};
 use triorder::mesh::keyframes::Keyframes;
 use triorder::mesh::source::AnimationSource;
 use triorder::mesh::{self, Mesh, report::MeshReport};
@@ -37,7 +38,16 @@ impl Measuring {
         };
         let views = m.views.as_deref().map(str::parse::<ViewSet>).transpose()?;
         let raster = raster::backend(&m.backend)?;
-        Ok(Measuring { options: MeasureOptions { caches, gpu_vertices, views, res: m.res, seed }, raster })
+        let render = m.render.iter().map(|s| Shading::parse(s)).collect::<Result<Vec<_>>>()?;
+        if !render.is_empty() && views.is_none() {
+            return Err(Error::usage("--render times every view of --views: give a view set"));
+        }
+        if !(1..=MAX_FRAMES).contains(&m.render_frames) {
+            return Err(Error::usage(format!("--render-frames {} is outside 1..={MAX_FRAMES}", m.render_frames)));
+        }
+        let options =
+            MeasureOptions { caches, gpu_vertices, views, res: m.res, seed, render, render_frames: m.render_frames };
+        Ok(Measuring { options, raster })
     }
 }
 

@@ -24,6 +24,7 @@ impl EvalTable {
         if let Some(views) = options.views {
             header.push(format!("OVR mean/max/var {views}@{}", options.res));
         }
+        header.extend(options.render.iter().map(|s| format!("{} ms", s.name())));
         EvalTable { header, rows: Vec::new() }
     }
 
@@ -52,6 +53,7 @@ impl EvalTable {
         if let Some(o) = &e.measurement.overdraw {
             row.push(summary_cell(o.summary));
         }
+        row.extend(e.measurement.render.iter().map(|r| format!("{:.3}", r.mean_ms())));
         self.rows.push(row);
     }
 
@@ -100,6 +102,18 @@ pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
         o.insert("backend".into(), json!(backend));
         let s = od.summary;
         insert_summary(&mut o, s, od.per_view.len());
+    }
+    if !e.measurement.render.is_empty() {
+        let render: Vec<Value> = e
+            .measurement
+            .render
+            .iter()
+            .map(|r| {
+                let per_view: Vec<f64> = r.per_view.iter().map(|t| t.median_ms).collect();
+                json!({"shading": r.shading.name(), "device": r.device, "mean_ms": r.mean_ms(), "per_view_ms": per_view})
+            })
+            .collect();
+        o.insert("render".into(), Value::Array(render));
     }
     Value::Object(o).to_string()
 }

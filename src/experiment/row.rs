@@ -8,7 +8,8 @@
 
 use serde::Serialize;
 
-use crate::eval::{Evaluation, GPU_CACHE, NodeEvaluation, Overdraw};
+use crate::eval::{Evaluation, GPU_CACHE, NodeEvaluation, Overdraw, RenderTime};
+use crate::gpu::render_time::Shading;
 use crate::mesh::{Mesh, simplify};
 use crate::metrics::CacheModel;
 
@@ -74,6 +75,18 @@ pub const METRICS: &[Metric] = &[
     Metric { name: "ovr_var", label: "variance of the overdraw ratio over views", needs: Needs::Views },
     Metric { name: "ovr_sum", label: "overdraw ratio (Σ shaded ÷ Σ covered)", needs: Needs::Views },
     Metric { name: "ovr_empty", label: "views that see nothing", needs: Needs::Views },
+    Metric {
+        name: "render_ms_pixel",
+        label: "frame time, pixel-bound shader (ms, mean over views)",
+        needs: Needs::Views,
+    },
+    Metric {
+        name: "render_ms_vertex",
+        label: "frame time, vertex-bound shader (ms, mean over views)",
+        needs: Needs::Views,
+    },
+    Metric { name: "render_ms_pixel_view", label: "frame time, pixel-bound shader (ms)", needs: Needs::Views },
+    Metric { name: "render_ms_vertex_view", label: "frame time, vertex-bound shader (ms)", needs: Needs::Views },
 ];
 
 /// One measurement. Field order is the column order ([`COLUMNS`]); `None` writes an empty cell.
@@ -118,7 +131,7 @@ pub struct Context {
     pub backend: String,
     pub machine: String,
     pub commit: String,
-    /// Whether to write the per-view `ovr` rows: only when the figure draws them. They are
+    /// Whether to write the per-view rows (`ovr`, `render_ms_*_view`): only when the figure draws them. They are
     /// one row per view per (model, method), which would make a 162-view run of every method
     /// on every model an 8 MB file, while the summaries are what the other figures read.
     pub per_view: bool,
@@ -145,9 +158,31 @@ impl Context {
         }
         if let Some(overdraw) = &eval.measurement.overdraw {
             self.overdraw_rows(&base, overdraw, &mut rows);
+            for render in &eval.measurement.render {
+                self.render_rows(&base, overdraw, render, &mut rows);
+            }
         }
         rows.push(base);
         rows
+    }
+
+    /// The render-time rows of one shader: the mean over views, and per view when the figure
+    /// draws them. Each names the device that rendered; `seconds` stays the ordering's time.
+    fn render_rows(&self, base: &Row, overdraw: &Overdraw, render: &RenderTime, rows: &mut Vec<Row>) {
+        let (mean, per_view) = match render.shading {
+            Shading::Pixel => ("render_ms_pixel", "render_ms_pixel_view"),
+            Shading::Vertex => ("render_ms_vertex", "render_ms_vertex_view"),
+        };
+        let timed = Row {
+            views: Some(overdraw.views.to_string()),
+            res: Some(overdraw.res),
+            backend: format!("gpu: {}", render.device),
+            ..base.clone()
+        };
+        rows.push(Row { metric: mean, value: render.mean_ms(), ..timed.clone() });
+        for (i, t) in render.per_view.iter().enumerate().filter(|_| self.per_view) {
+            rows.push(Row { metric: per_view, view: Some(i), value: t.median_ms, ..timed.clone() });
+        }
     }
 
     /// The rows of one index-buffer evaluation of `model` (as the spec names it): draw-weighted

@@ -78,7 +78,7 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Vec<(PathBuf
     let mut gpu_specs = Vec::new();
     for spec in &specs {
         let work = spec.workload(opts.quick)?;
-        if opts.backend.is_none() && (spec.backend == "gpu" || work.gpu_vertices) {
+        if opts.backend.is_none() && (spec.backend == "gpu" || work.gpu_vertices || !spec.render.is_empty()) {
             gpu_specs.push(spec.id.clone());
         }
     }
@@ -122,6 +122,8 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
         views: work.views,
         res: work.res,
         seed: spec.seed,
+        render: spec.render.clone(),
+        render_frames: spec.render_frames,
     };
     let context = Context {
         experiment: spec.id.clone(),
@@ -129,7 +131,7 @@ fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Path
         backend: raster.describe(),
         machine: provenance::machine(),
         commit: provenance::commit(),
-        per_view: spec.figure.metrics.iter().any(|m| m == "ovr"),
+        per_view: spec.figure.metrics.iter().any(|m| m == "ovr" || m.ends_with("_view")),
     };
 
     let bar = bars.add(ProgressBar::new((work.models.len() * methods.len()) as u64));

@@ -32,6 +32,9 @@
 //! res = 512                        # optional, with views only: image size R×R (default 512)
 //! seed = 0                         # optional (default 0): seeds random orders, random views, disk:N
 //! backend = "cpu"                  # optional (default cpu): the raster backend, cpu or gpu
+//! render = ["pixel", "vertex"]     # optional, with views: time rendering on the GPU from every
+//!                                  # view with a pixel-bound and/or a vertex-bound shader
+//! render_frames = 30               # optional: timed frames per view and shader (default 30)
 //!
 //! [figure]
 //! kind = "line"                    # line | scatter | bar | distribution | table |
@@ -81,6 +84,7 @@ use serde::Deserialize;
 use super::row::{COLUMNS, METRICS, Needs};
 use crate::error::{Error, Result};
 use crate::eval::GPU_CACHE;
+use crate::gpu::render_time::{MAX_FRAMES, Shading};
 use crate::mesh::source::AnimationSource;
 use crate::mesh::{procedural, simplify};
 use crate::metrics::CacheModel;
@@ -89,6 +93,9 @@ use crate::raster::{self, ViewSet};
 
 /// Overdraw image size when a spec gives views but no `res` (Nehab et al. 2006 use 512×512).
 pub const DEFAULT_RES: u32 = 512;
+
+/// Timed frames per view and shader when a spec renders but does not say how many.
+pub const DEFAULT_RENDER_FRAMES: usize = 30;
 
 /// Largest image side a spec may ask for: beyond it one depth buffer alone needs gigabytes.
 const MAX_RES: u32 = 16384;
@@ -108,6 +115,10 @@ pub struct Spec {
     pub claim: Option<String>,
     pub seed: u64,
     pub backend: String,
+    /// Shaders to time rendering with on the GPU, from every view (`render = ["pixel", "vertex"]`).
+    pub render: Vec<Shading>,
+    /// Timed frames per view and shader (`render_frames`, default [`DEFAULT_RENDER_FRAMES`]).
+    pub render_frames: usize,
     /// Canonical method specs (every parameter written out), grids expanded, duplicates
     /// removed, in the order the spec lists them.
     pub methods: Vec<String>,
@@ -266,6 +277,9 @@ struct RawSpec {
     #[serde(default)]
     seed: u64,
     backend: Option<String>,
+    #[serde(default)]
+    render: Vec<String>,
+    render_frames: Option<usize>,
     figure: RawFigure,
     quick: Option<RawQuick>,
 }
@@ -389,6 +403,34 @@ impl RawSpec {
                 "figure.kind = \"hardware-fit\" compares simulated caches with the GPU's counts: caches must list simulated models and `{GPU_CACHE}`"
             )));
         }
+        let render = self
+            .render
+            .iter()
+            .map(|s| Shading::parse(s))
+            .collect::<Result<Vec<_>>>()
+            .map_err(|e| err(format!("render: {e}")))?;
+        let render_frames = self.render_frames.unwrap_or(DEFAULT_RENDER_FRAMES);
+        if !(1..=MAX_FRAMES).contains(&render_frames) {
+            return Err(err(format!("render_frames = {render_frames} is not in 1..={MAX_FRAMES}")));
+        }
+        for metric in &figure.metrics {
+            let shading = metric.strip_prefix("render_ms_").map(|s| s.trim_end_matches("_view"));
+            if let Some(shading) = shading.and_then(|s| Shading::parse(s).ok())
+                && !render.contains(&shading)
+            {
+                return Err(err(format!("figure.metric = \"{metric}\" needs render = [\"{}\"]", shading.name())));
+            }
+        }
+        if !render.is_empty() {
+            if full.views.is_none() || quick.as_ref().is_some_and(|q| q.views.is_none()) {
+                return Err(err("render times every view of `views`: set views".into()));
+            }
+            if let Some(what) = &per_node {
+                return Err(err(format!(
+                    "render times one index buffer per model and method on the GPU, but {what} gives an index buffer per (keyframe, view)"
+                )));
+            }
+        }
         if gpu_vertices && let Some(what) = &per_node {
             return Err(err(format!(
                 "caches names `{GPU_CACHE}`, which counts one index buffer per model and method on the GPU, but {what} gives an index buffer per (keyframe, view)"
@@ -410,6 +452,8 @@ impl RawSpec {
             claim: self.claim.filter(|c| !c.trim().is_empty()),
             seed: self.seed,
             backend,
+            render,
+            render_frames,
             methods,
             full,
             quick,

@@ -7,6 +7,7 @@
 //! validation or out-of-memory error, a submission that does not finish within [`WAIT`].
 //! Nothing here panics on a driver's answer.
 
+pub mod render_time;
 pub mod vertex_reuse;
 
 use std::sync::{Arc, Mutex, OnceLock};
