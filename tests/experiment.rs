@@ -140,6 +140,14 @@ modles = ["a"]"#,
         (r#"x = "cache_size""#, r#"x = "param:nope""#, &["figure.x", "no method of this spec has a parameter `nope`"]),
         (r#"x = "cache_size""#, r#"x = "metric:atvr""#, &["figure.x", "metric:atvr"]),
         (r#"kind = "line""#, "kind = \"bar\"\nx_log = true", &["figure.x_log", "bar"]),
+        (r#"kind = "line""#, "kind = \"ratio\"", &["figure.ratio = [A, B]"]),
+        (r#"kind = "line""#, "kind = \"ratio\"\nratio = [\"input\", \"nope\"]", &["figure.ratio names `nope`"]),
+        (r#"kind = "line""#, "kind = \"ratio\"\nratio = [\"input\", \"random\"]", &["x = \"metric:NAME\""]),
+        (
+            r#"kind = "line""#,
+            "kind = \"bar\"\nratio = [\"input\", \"random\"]",
+            &["figure.ratio is for kind = \"ratio\""],
+        ),
         (
             r#"models = ["sphere:80", "grid:4x4"]
 "#,

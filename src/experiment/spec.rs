@@ -40,7 +40,8 @@
 //! kind = "line"                    # line | scatter | bar | distribution | table |
 //!                                  # sequence | corners | clusters | cluster-order | overdraw
 //!                                  # (drawings of the meshes) | hardware-fit (simulated cache
-//!                                  # models against the GPU's counts)
+//!                                  # models against the GPU's counts) | ratio (per view, method
+//!                                  # A over B of x against y; needs ratio = ["A", "B"])
 //! metric = "acmr"                  # the y values: rows whose `metric` column is this
 //!                                  # (acmr, atvr, seconds, ovr, ovr_mean, ovr_max, ovr_min,
 //!                                  # ovr_var, ovr_sum, ovr_empty), or a list of metrics drawn
@@ -163,6 +164,8 @@ pub struct Figure {
     pub label: Option<String>,
     /// Drawing kinds: the direction the model is seen from (centre → eye), default +z.
     pub view: [f32; 3],
+    /// Kind `ratio`: the method names whose values are divided, numerator first.
+    pub ratio: Option<(String, String)>,
 }
 
 /// The chart kinds `triorder plot` draws.
@@ -201,6 +204,10 @@ pub enum FigureKind {
     /// winner's simulated against counted ACMR (issue 6).
     #[serde(rename = "hardware-fit")]
     HardwareFit,
+    /// Per view, one method's value over another's (`ratio = [A, B]`) of the x metric against
+    /// that of the y metric, with Pearson's r per series (Nehab et al. 2006, Fig. 10: overdraw
+    /// ratio against render-time ratio, nehab over hoppe).
+    Ratio,
 }
 
 impl FigureKind {
@@ -334,6 +341,7 @@ struct RawFigure {
     y_range: Option<[f64; 2]>,
     label: Option<String>,
     view: Option<[f32; 3]>,
+    ratio: Option<[String; 2]>,
 }
 
 /// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
@@ -642,7 +650,7 @@ impl RawFigure {
             }
             (FigureKind::Distribution, None) => {}
             (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
-            (k, Some(x)) => column("figure.x", x, k == FigureKind::Scatter)?,
+            (k, Some(x)) => column("figure.x", x, matches!(k, FigureKind::Scatter | FigureKind::Ratio))?,
         }
         if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.fixed_layout()) {
             return Err(format!("figure.x_log / y_log: kind = \"{}\" has no axes", kind_name(self.kind)));
@@ -675,6 +683,25 @@ impl RawFigure {
             }
             column("figure.label", label, true)?;
         }
+        let ratio = match (self.kind, self.ratio) {
+            (FigureKind::Ratio, None) => {
+                return Err("figure.ratio = [A, B] (method names) is required for kind = \"ratio\"".into());
+            }
+            (FigureKind::Ratio, Some([a, b])) => {
+                let names: Vec<&str> = methods.iter().map(|m| m.split(':').next().unwrap_or(m)).collect();
+                if let Some(missing) = [&a, &b].into_iter().find(|n| !names.contains(&n.as_str())) {
+                    return Err(format!("figure.ratio names `{missing}`, which is not a method of this spec"));
+                }
+                if !self.x.as_deref().is_some_and(|x| x.starts_with("metric:")) || metrics.len() != 1 {
+                    return Err("kind = \"ratio\" needs x = \"metric:NAME\" and one metric, both per view".into());
+                }
+                Some((a, b))
+            }
+            (_, Some(_)) => {
+                return Err(format!("figure.ratio is for kind = \"ratio\", not \"{}\"", kind_name(self.kind)));
+            }
+            (_, None) => None,
+        };
         let y_range = match self.y_range {
             Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
                 return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
@@ -699,6 +726,7 @@ impl RawFigure {
             y_range,
             label: self.label,
             view,
+            ratio,
         })
     }
 }
@@ -716,6 +744,7 @@ fn kind_name(kind: FigureKind) -> &'static str {
         FigureKind::Overdraw => "overdraw",
         FigureKind::Corners => "corners",
         FigureKind::HardwareFit => "hardware-fit",
+        FigureKind::Ratio => "ratio",
     }
 }
 

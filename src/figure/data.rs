@@ -109,6 +109,22 @@ impl Table {
         }
     }
 
+    /// Every row of `metric`: the cells of `columns`, and the value.
+    pub fn rows(&self, metric: &str, columns: &[&str]) -> Result<Vec<(Vec<String>, f64)>> {
+        let (metric_col, value_col) = (self.column("metric")?, self.column("value")?);
+        let indices = columns.iter().map(|c| self.column(c)).collect::<Result<Vec<_>>>()?;
+        self.records
+            .iter()
+            .filter(|r| &r[metric_col] == metric)
+            .map(|r| {
+                let value = r[value_col].parse().map_err(|_| {
+                    Error::input(self.path.display(), format!("`{metric}` value `{}` is not a number", &r[value_col]))
+                })?;
+                Ok((indices.iter().map(|&i| r[i].to_string()).collect(), value))
+            })
+            .collect()
+    }
+
     /// The distinct non-empty combinations of `columns` (missing columns: none), in order.
     pub fn distinct(&self, columns: &[&str]) -> Vec<Vec<String>> {
         let Ok(indices) = columns.iter().map(|c| self.column(c)).collect::<Result<Vec<_>>>() else {

@@ -13,6 +13,7 @@ pub(crate) mod data;
 mod distribution;
 mod drawing;
 mod hardware_fit;
+mod ratio;
 mod table;
 mod xy;
 
@@ -55,7 +56,8 @@ pub fn plot(spec: &Path, opts: &PlotOptions) -> Result<PathBuf> {
 pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
     let csv = spec.csv_path(&opts.out_dir, opts.quick);
     let table = Table::read(&csv)?;
-    let panels = table.select(&spec.figure)?;
+    // Panels of series, for the chart kinds; the other kinds lay out their own figure.
+    let panels;
     let figure = &spec.figure;
     let mut setup: Vec<String> = table
         .distinct(&["views", "res"])
@@ -67,18 +69,29 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
     }
     let kind: Box<dyn Kind> = match figure.kind {
         FigureKind::Line | FigureKind::Scatter => {
+            panels = table.select(figure)?;
             let x = figure.x.as_deref().unwrap_or_default();
             Box::new(xy::Xy::new(&panels, x, figure.kind == FigureKind::Line, &csv)?)
         }
-        FigureKind::Bar => Box::new(bar::Bars::new(&panels)),
-        FigureKind::Distribution => Box::new(distribution::Distribution::new(&panels)),
-        FigureKind::Table => Box::new(table::Tables(bar::Bars::new(&panels))),
+        FigureKind::Bar => {
+            panels = table.select(figure)?;
+            Box::new(bar::Bars::new(&panels))
+        }
+        FigureKind::Distribution => {
+            panels = table.select(figure)?;
+            Box::new(distribution::Distribution::new(&panels))
+        }
+        FigureKind::Table => {
+            panels = table.select(figure)?;
+            Box::new(table::Tables(bar::Bars::new(&panels)))
+        }
         FigureKind::Sequence
         | FigureKind::Corners
         | FigureKind::Clusters
         | FigureKind::ClusterOrder
         | FigureKind::Overdraw => return drawing::plot(spec, opts, &table),
         FigureKind::HardwareFit => return hardware_fit::plot(spec, opts, &table),
+        FigureKind::Ratio => return ratio::plot(spec, opts, &table),
     };
     // Panels share their axes, except panels of different metrics, whose units differ.
     let frames = if figure.facet.as_deref() == Some("metric") {
