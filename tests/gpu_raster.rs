@@ -138,16 +138,9 @@ x = "method"
             ..Default::default()
         };
         let csv = triorder::experiment::run(&spec, &options).unwrap();
-        let mut reader = csv::Reader::from_path(csv).unwrap();
-        let header = reader.headers().unwrap().clone();
-        let column = |name: &str| header.iter().position(|h| h == name).unwrap();
-        let (backend, metric, value) = (column("backend"), column("metric"), column("value"));
-        reader
-            .records()
-            .map(|r| {
-                let r = r.unwrap();
-                (r[backend].to_string(), r[metric].to_string(), r[value].to_string())
-            })
+        common::csv_rows(&csv)
+            .into_iter()
+            .map(|r| (r["backend"].clone(), r["metric"].clone(), r["value"].clone()))
             .collect::<Vec<_>>()
     };
     let (cpu, on_gpu) = (read("cpu"), read("gpu"));

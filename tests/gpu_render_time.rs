@@ -79,16 +79,12 @@ facet = "model"
     std::fs::write(&spec, text).unwrap();
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
     let csv = triorder::experiment::run(&spec, &options).unwrap();
-    let mut reader = csv::Reader::from_path(csv).unwrap();
-    let header = reader.headers().unwrap().clone();
-    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let (metric, backend, view) = (column("metric"), column("backend"), column("view"));
-    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-    let timed: Vec<_> = rows.iter().filter(|r| r[metric].starts_with("render_ms")).collect();
+    let rows = common::csv_rows(&csv);
+    let timed: Vec<_> = rows.iter().filter(|r| r["metric"].starts_with("render_ms")).collect();
     // 2 models × 2 methods × (1 mean + 6 views).
     assert_eq!(timed.len(), 28);
-    assert!(timed.iter().all(|r| r[backend] == format!("gpu: {}", timer.device())));
-    assert_eq!(timed.iter().filter(|r| !r[view].is_empty()).count(), 24);
+    assert!(timed.iter().all(|r| r["backend"] == format!("gpu: {}", timer.device())));
+    assert_eq!(timed.iter().filter(|r| !r["view"].is_empty()).count(), 24);
     // A figure of vertex-bound times needs render = ["vertex"]; rendering needs views.
     let vertex = text.replace("render_ms_pixel_view", "render_ms_vertex");
     std::fs::write(&spec, &vertex).unwrap();

@@ -97,16 +97,12 @@ series = "cache"
     std::fs::write(&spec, text).unwrap();
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
     let csv = triorder::experiment::run(&spec, &options).unwrap();
-    let mut reader = csv::Reader::from_path(csv).unwrap();
-    let header = reader.headers().unwrap().clone();
-    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let (cache, backend, metric) = (column("cache"), column("backend"), column("metric"));
-    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-    let counted: Vec<_> = rows.iter().filter(|r| &r[cache] == "gpu").collect();
+    let rows = common::csv_rows(&csv);
+    let counted: Vec<_> = rows.iter().filter(|r| r["cache"] == "gpu").collect();
     // Two models × two methods × (acmr, atvr), each naming the device that counted it.
     assert_eq!(counted.len(), 8);
-    assert!(counted.iter().all(|r| r[backend] == format!("gpu: {}", counter.device())));
-    assert_eq!(counted.iter().filter(|r| &r[metric] == "acmr").count(), 4);
+    assert!(counted.iter().all(|r| r["backend"] == format!("gpu: {}", counter.device())));
+    assert_eq!(counted.iter().filter(|r| r["metric"] == "acmr").count(), 4);
     // A spec cannot ask the GPU to count a per-(keyframe, view) method.
     std::fs::write(&spec, text.replace(r#"["input", "random"]"#, r#"["hs17"]"#)).unwrap();
     let err = triorder::experiment::run(&spec, &options).unwrap_err().to_string();

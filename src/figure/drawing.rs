@@ -24,7 +24,7 @@ use plotters::prelude::*;
 
 use super::axes::{self, DrawResult, FONT};
 use super::data::Table;
-use super::{Header, PlotOptions};
+use super::{Header, PlotOptions, save};
 use crate::error::{Error, Result};
 use crate::experiment::row::OrderRow;
 use crate::experiment::spec::{FigureKind, Spec};
@@ -172,10 +172,7 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
     }
     let path = spec.svg_path(&opts.out_dir, opts.quick);
     let svg = render(spec, opts.quick, &drawings).map_err(|e| Error::output(&path, format!("cannot draw: {e}")))?;
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| Error::output(&path, e))?;
-    }
-    crate::atomic::write(&path, svg.as_bytes())?;
+    save(&path, &svg)?;
     Ok(path)
 }
 

@@ -113,11 +113,16 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
     let mut svg = String::new();
     draw(&mut svg, spec, &setup.join(" · "), &panels, kind.as_ref(), &frames, &colors)
         .map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| Error::output(&path, e))?;
-    }
-    crate::atomic::write(&path, svg.as_bytes())?;
+    save(&path, &svg)?;
     Ok(path)
+}
+
+/// Writes a finished figure to `path` atomically, creating its folder.
+fn save(path: &Path, svg: &str) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output(path, e))?;
+    }
+    crate::atomic::write(path, svg.as_bytes())
 }
 
 /// A chart kind: its data, prepared from the panels, and how one panel of it is drawn.

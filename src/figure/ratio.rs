@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::axes::{self, Area, Colors, DrawResult, Frame, Painter};
 use super::data::Table;
-use super::{Header, PlotOptions};
+use super::{Header, PlotOptions, save};
 use crate::error::{Error, Result};
 use crate::experiment::spec::Spec;
 
@@ -121,10 +121,7 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
         axes::legend(&legend, colors.entries(), axes::Swatch::Point)
     })();
     drawn.map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| Error::output(&path, e))?;
-    }
-    crate::atomic::write(&path, svg.as_bytes())?;
+    save(&path, &svg)?;
     Ok(path)
 }
 

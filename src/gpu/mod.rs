@@ -35,8 +35,17 @@ const OPTIONAL: wgpu::Features = wgpu::Features::PIPELINE_STATISTICS_QUERY.union
 /// The process's GPU, opened once; the error, if opening failed, is returned on every call.
 pub fn shared() -> Result<&'static Gpu> {
     static GPU: OnceLock<std::result::Result<Gpu, String>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Gpu::open().map_err(|e| match e {
+    once(&GPU, Gpu::open)
+}
+
+/// The object in `cell`, built by `build` on first use. Pipelines are built once per process;
+/// a failure is kept and returned, as the same error, on every later call.
+pub fn once<T>(
+    cell: &'static OnceLock<std::result::Result<T, String>>,
+    build: impl FnOnce() -> Result<T>,
+) -> Result<&'static T> {
+    cell.get_or_init(|| {
+        build().map_err(|e| match e {
             Error::Gpu(message) => message,
             other => other.to_string(),
         })
@@ -165,6 +174,17 @@ impl Gpu {
         drop(bytes);
         readback.unmap();
         Ok(out)
+    }
+
+    /// The vertex buffer of `vertices` (floats, interleaved as the pipeline reads them) and the
+    /// index buffer of `triangles`, with the index count.
+    pub fn mesh_buffers(&self, vertices: &[f32], triangles: &[[u32; 3]]) -> Result<(wgpu::Buffer, wgpu::Buffer, u32)> {
+        let indices: &[u32] = bytemuck::cast_slice(triangles);
+        let vertex = self.buffer_init("vertex buffer", bytemuck::cast_slice(vertices), wgpu::BufferUsages::VERTEX)?;
+        let index = self.buffer_init("index buffer", bytemuck::cast_slice(indices), wgpu::BufferUsages::INDEX)?;
+        let count = u32::try_from(indices.len())
+            .map_err(|_| Error::Gpu(format!("{}: {} indices do not fit one draw", self.info.name, indices.len())))?;
+        Ok((vertex, index, count))
     }
 
     /// A buffer of `bytes` for `usage`, or an error if it exceeds the device's buffer limit

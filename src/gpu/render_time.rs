@@ -123,15 +123,7 @@ const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The process's timer, built once; the error, if building failed, is returned on every call.
 pub fn shared() -> Result<&'static RenderTimer> {
     static TIMER: std::sync::OnceLock<std::result::Result<RenderTimer, String>> = std::sync::OnceLock::new();
-    TIMER
-        .get_or_init(|| {
-            RenderTimer::new().map_err(|e| match e {
-                Error::Gpu(message) => message,
-                other => other.to_string(),
-            })
-        })
-        .as_ref()
-        .map_err(|e| Error::Gpu(e.clone()))
+    super::once(&TIMER, RenderTimer::new)
 }
 
 impl RenderTimer {
@@ -235,14 +227,7 @@ impl RenderTimer {
             let device = &self.gpu.device;
             let interleaved: Vec<f32> =
                 positions.iter().zip(&normals).flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z]).collect();
-            let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
-            let vertices = self.gpu.buffer_init(
-                "vertex buffer",
-                bytemuck::cast_slice(&interleaved),
-                wgpu::BufferUsages::VERTEX,
-            )?;
-            let index =
-                self.gpu.buffer_init("index buffer", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX)?;
+            let (vertices, index, index_count) = self.gpu.mesh_buffers(&interleaved, triangles)?;
             let mut uniform = camera.view_proj.to_cols_array().to_vec();
             uniform.extend(camera.eye.extend(1.0).to_array());
             let uniform = self.gpu.buffer_init("view", bytemuck::cast_slice(&uniform), wgpu::BufferUsages::UNIFORM)?;
@@ -310,7 +295,7 @@ impl RenderTimer {
                 pass.set_bind_group(0, &bind_group, &[]);
                 pass.set_vertex_buffer(0, vertices.slice(..));
                 pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..indices.len() as u32, 0, 0..1);
+                pass.draw_indexed(0..index_count, 0, 0..1);
             }
             let resolved = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame times"),

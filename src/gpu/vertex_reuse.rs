@@ -27,15 +27,7 @@ fn main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
 /// The process's counter, built once; the error, if building failed, is returned on every call.
 pub fn shared() -> Result<&'static VertexCounter> {
     static COUNTER: std::sync::OnceLock<std::result::Result<VertexCounter, String>> = std::sync::OnceLock::new();
-    COUNTER
-        .get_or_init(|| {
-            VertexCounter::new().map_err(|e| match e {
-                Error::Gpu(message) => message,
-                other => other.to_string(),
-            })
-        })
-        .as_ref()
-        .map_err(|e| Error::Gpu(e.clone()))
+    super::once(&COUNTER, VertexCounter::new)
 }
 
 /// Counts vertex-shader invocations on the shared GPU.
@@ -128,12 +120,7 @@ impl VertexCounter {
         let referenced = seen.iter().filter(|&&s| s).count();
         let invocations = self.gpu.checked("counting vertex-shader invocations", || {
             let device = &self.gpu.device;
-            let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
-            let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
-            let vertices =
-                self.gpu.buffer_init("vertex buffer", bytemuck::cast_slice(&flat), wgpu::BufferUsages::VERTEX)?;
-            let index =
-                self.gpu.buffer_init("index buffer", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX)?;
+            let (vertices, index, index_count) = self.gpu.mesh_buffers(bytemuck::cast_slice(positions), triangles)?;
             let queries = device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("vertex invocations"),
                 ty: wgpu::QueryType::PipelineStatistics(wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS),
@@ -160,7 +147,7 @@ impl VertexCounter {
                 pass.set_vertex_buffer(0, vertices.slice(..));
                 pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
                 pass.begin_pipeline_statistics_query(&queries, 0);
-                pass.draw_indexed(0..indices.len() as u32, 0, 0..1);
+                pass.draw_indexed(0..index_count, 0, 0..1);
                 pass.end_pipeline_statistics_query();
             }
             let resolved = device.create_buffer(&wgpu::BufferDescriptor {

@@ -191,7 +191,7 @@ impl GpuRaster {
         let positions: Vec<Vec3> = corners.iter().map(|&(x, y)| Vec3::new(x, y, 0.5)).collect();
         let quad = [[0, 1, 2], [0, 2, 3]];
         let camera = Camera { view_proj: Mat4::IDENTITY, eye: Vec3::Z, forward: Vec3::NEG_Z, perspective: false };
-        let counts = self.draw(&positions, &[quad, quad].concat(), &[camera], res)?;
+        let counts = self.count(&positions, &[quad, quad].concat(), &[camera], res)?;
         let area = u64::from(res * res);
         let expected = ViewCounts { covered: area, fragments: 2 * area, passed: area };
         if counts[0] != expected {
@@ -202,48 +202,6 @@ impl GpuRaster {
             )));
         }
         Ok(())
-    }
-
-    fn draw(
-        &self,
-        positions: &[Vec3],
-        triangles: &[[u32; 3]],
-        cameras: &[Camera],
-        res: u32,
-    ) -> Result<Vec<ViewCounts>> {
-        let limit = self.gpu.device.limits().max_texture_dimension_2d.min(MAX_RESOLUTION);
-        if !(1..=limit).contains(&res) {
-            return Err(Error::usage(format!("resolution {res} is outside 1..={limit} ({})", self.device())));
-        }
-        check_projection(positions, cameras, res)?;
-        if cameras.is_empty() {
-            return Ok(Vec::new());
-        }
-        self.gpu.checked("counting fragments", || {
-            let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
-            let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
-            let vertices =
-                self.gpu.buffer_init("vertex buffer", bytemuck::cast_slice(&flat), wgpu::BufferUsages::VERTEX)?;
-            let index =
-                self.gpu.buffer_init("index buffer", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX)?;
-            let depth = self.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("depth"),
-                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: DEPTH,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            });
-            let depth = depth.create_view(&Default::default());
-            let mesh = Mesh { vertices: &vertices, index: &index, index_count: indices.len() as u32, depth: &depth };
-            let mut counts = Vec::with_capacity(cameras.len());
-            for batch in cameras.chunks(BATCH) {
-                counts.extend(self.draw_batch(&mesh, batch)?);
-            }
-            Ok(counts)
-        })
     }
 
     fn draw_batch(&self, mesh: &Mesh, cameras: &[Camera]) -> Result<Vec<ViewCounts>> {
@@ -358,7 +316,34 @@ impl RasterBackend for GpuRaster {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>> {
-        self.draw(positions, triangles, cameras, res)
+        let limit = self.gpu.device.limits().max_texture_dimension_2d.min(MAX_RESOLUTION);
+        if !(1..=limit).contains(&res) {
+            return Err(Error::usage(format!("resolution {res} is outside 1..={limit} ({})", self.device())));
+        }
+        check_projection(positions, cameras, res)?;
+        if cameras.is_empty() {
+            return Ok(Vec::new());
+        }
+        self.gpu.checked("counting fragments", || {
+            let (vertices, index, index_count) = self.gpu.mesh_buffers(bytemuck::cast_slice(positions), triangles)?;
+            let depth = self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("depth"),
+                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            let depth = depth.create_view(&Default::default());
+            let mesh = Mesh { vertices: &vertices, index: &index, index_count, depth: &depth };
+            let mut counts = Vec::with_capacity(cameras.len());
+            for batch in cameras.chunks(BATCH) {
+                counts.extend(self.draw_batch(&mesh, batch)?);
+            }
+            Ok(counts)
+        })
     }
 }
 

@@ -67,3 +67,10 @@ pub fn backends() -> Vec<&'static dyn triorder::raster::RasterBackend> {
     }
     all
 }
+
+/// A results CSV as one column → value map per row.
+pub fn csv_rows(path: &std::path::Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    reader.records().map(|r| header.iter().cloned().zip(r.unwrap().iter().map(String::from)).collect()).collect()
+}
