@@ -138,24 +138,28 @@ impl Topology {
 /// (so a repeated corner lists it twice). [`Topology::new`] builds it; the benchmark builds it
 /// alone to time an ordering together with the adjacency it needs, as meshoptimizer's are timed.
 pub fn vertex_triangles(mesh: &Mesh) -> Csr {
-    // Csr::from_pairs specialised to three items per triangle: plain loops, as this is on the
-    // path of every ordering that is timed with its adjacency.
-    let mut offsets = vec![0u32; mesh.vertex_count() + 1];
-    for &v in mesh.triangles.iter().flatten() {
-        offsets[v as usize + 1] += 1;
+    // Csr::from_pairs specialised to three items per triangle, as this is on the path of every
+    // ordering that is timed with its adjacency. Vertex v is counted at `offsets[v + 2]`, so the
+    // prefix sum leaves `offsets[v + 1]` at row v's start; filling the row advances it to the
+    // row's end, which is row v + 1's start. The offsets thus come out right with no copy of them
+    // as write cursors and no pass to rewind those cursors; the one slot too many is dropped.
+    let n = mesh.vertex_count();
+    let mut offsets = vec![0u32; n + 2];
+    for &v in mesh.triangles.as_flattened() {
+        offsets[v as usize + 2] += 1;
     }
-    for i in 1..offsets.len() {
+    for i in 2..offsets.len() {
         offsets[i] += offsets[i - 1];
     }
-    let mut cursor = offsets.clone();
     let mut items = vec![0u32; 3 * mesh.triangles.len()];
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for &v in tri {
-            let slot = &mut cursor[v as usize];
-            items[*slot as usize] = t as u32;
-            *slot += 1;
+            let end = &mut offsets[v as usize + 1];
+            items[*end as usize] = t as u32;
+            *end += 1;
         }
     }
+    offsets.pop();
     Csr { offsets, items }
 }
 
@@ -222,6 +226,20 @@ mod tests {
             assert_eq!(t.neighbors.row(tri).len(), 3);
         }
         assert_eq!(t.vertex_triangles.row(0), &[0, 1, 3]);
+    }
+
+    #[test]
+    fn vertex_triangles_lists_each_corner_in_triangle_order() {
+        // A repeated corner, and vertices 1 and 5 used by no triangle (empty rows).
+        let m = mesh(
+            &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [1., 1., 0.], [0., 0., 1.], [1., 0., 1.]],
+            &[[0, 2, 3], [3, 3, 4], [4, 0, 2], [2, 4, 3]],
+        );
+        let pairs = m.triangles.iter().enumerate().flat_map(|(t, tri)| tri.map(|v| (v, t as u32)));
+        let expected = Csr::from_pairs(m.vertex_count(), pairs);
+        assert_eq!(vertex_triangles(&m), expected);
+        assert_eq!(expected.row(3), &[0, 1, 1, 3]);
+        assert_eq!(expected.row(5), &[] as &[u32]);
     }
 
     #[test]
