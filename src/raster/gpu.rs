@@ -1,5 +1,5 @@
 //! The GPU raster backend: the same per-view counts as [`super::cpu::CpuRaster`], drawn by a real
-//! Vulkan device through wgpu and counted by occlusion queries.
+//! Vulkan device through wgpu and counted by occlusion queries and a fragment-shader counter.
 //!
 //! Per view, in one render pass over an R×R `Depth32Float` buffer cleared to 1.0, two draws:
 //! 1. The mesh in draw order, back faces culled (counter-clockwise is front, NDC y up, as on the
@@ -7,17 +7,17 @@
 //!    **passed**. The fragment shader adds one to an atomic counter for the view: because it
 //!    writes to memory, Vulkan runs it before the depth test, for every rasterized fragment, so
 //!    the counter is **fragments** (GPU.md: exact on lavapipe and on an H100). The counter is
-//!    spread over [`LANES`] words by pixel, so fragments of one view do not all contend for one
-//!    address, and no word can overflow.
+//!    spread over [`LANES`] words, a 64-byte line per 64×64-pixel tile (16 lines, by tile) and a
+//!    word per column within it, so fragments do not all contend for one address, threads
+//!    drawing different tiles rarely share a line, and no word can overflow.
 //! 2. A full-screen triangle at depth 1.0 tested GREATER without writes, which passes exactly
 //!    where some fragment left a depth below 1.0: **covered**, by a second query.
 //!
 //! One mesh draw per view, not two: drawing is what costs (lavapipe spends it in vertex
 //! processing and triangle setup, which it runs on one thread).
 //!
-//! The rules the
-//! CPU reference spells out (pixel centres, top-left rule, LESS, clear to 1.0) are Vulkan's own; the
-//! CPU snaps to 8 sub-pixel bits as Vulkan devices do. What can still differ is below the rules:
+//! The rules the CPU reference spells out (pixel centres, top-left rule, LESS, clear to 1.0) are
+//! Vulkan's own; the CPU snaps to 8 sub-pixel bits as Vulkan devices do. What can still differ is below the rules:
 //! how a device rounds to its sub-pixel grid and interpolates depth. A fragment whose depth ties
 //! with, or lies within a rounding error of, an earlier one may pass on one backend and not the
 //! other. tests/gpu_raster.rs measures that difference and holds it under 0.1% of fragments.
