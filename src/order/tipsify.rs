@@ -67,7 +67,7 @@ pub(crate) fn tipsify(triangles: &[[u32; 3]], vertex_triangles: &Csr, cache: u32
         triangles,
         vertices: offsets.windows(2).map(|w| Vertex { live: w[1] - w[0], stamp: 0 }).collect(),
         emitted: vec![false; n],
-        dead_end: vec![0; 2 * n + 1],
+        dead_end: vec![0; 2 * n],
         top: 0,
         order: vec![0; n],
         count: 0,
@@ -81,6 +81,11 @@ pub(crate) fn tipsify(triangles: &[[u32; 3]], vertex_triangles: &Csr, cache: u32
     loop {
         let mut fan = next_neighbour(&fans.dead_end[candidates_from..fans.top], &fans.vertices, fans.now, cache);
         if fan == NONE {
+            // Every triangle is out: stop here rather than pop the rest of the stack and scan the
+            // remaining vertex ids only to find them all dead.
+            if fans.count == n {
+                break;
+            }
             fan = next_after_dead_end(&fans.dead_end, &mut fans.top, &mut cursor, &fans.vertices);
             if fan == NONE {
                 break;
@@ -97,10 +102,9 @@ pub(crate) fn tipsify(triangles: &[[u32; 3]], vertex_triangles: &Csr, cache: u32
 /// current fan doubles as the candidate set for the next fan vertex, so no separate set is kept.
 /// The fan vertex itself is not pushed: once its fan is drawn it has no live triangle left, so it
 /// can be neither a candidate nor a dead-end restart, and leaving it out takes a third of the
-/// entries off both scans (which skip dead vertices one unpredictable test at a time). A triangle
-/// thus pushes at most two corners: `top <= 2 * count`, and the three slots a triangle writes end
-/// within `2 * n + 1`. So the buffers are sized once and written by index, with no allocation or
-/// growth check per step.
+/// entries off both scans (which skip dead vertices one unpredictable test at a time). Each
+/// triangle pushes exactly its two corners other than the fan vertex, so `top <= 2 * count` and
+/// the buffers are sized once and written by index, with no allocation or growth check per step.
 struct Fans<'a> {
     triangles: &'a [[u32; 3]],
     vertices: Vec<Vertex>,
@@ -125,7 +129,7 @@ impl Fans<'_> {
     fn emit(&mut self, fan: u32, row: &[u32]) {
         let Fans { triangles, vertices, emitted, dead_end, order, cache, .. } = self;
         let n = triangles.len();
-        let (emitted, order, dead_end) = (&mut emitted[..n], &mut order[..n], &mut dead_end[..2 * n + 1]);
+        let (emitted, order, dead_end) = (&mut emitted[..n], &mut order[..n], &mut dead_end[..2 * n]);
         let (mut top, mut count, mut now) = (self.top, self.count, self.now);
         // Stop once the fan's live triangles are all out rather than test the rest of its row,
         // counting them off instead of reloading the fan's live count at every entry. (A triangle
@@ -140,12 +144,17 @@ impl Fans<'_> {
             *flag = true;
             order[count] = t;
             count += 1;
-            // All three corners are written; the stack grows past the fan's neighbours only.
-            let slots = &mut dead_end[top..][..3];
-            let mut pushed = 0;
-            for v in triangles[t as usize] {
-                slots[pushed] = v;
-                pushed += usize::from(v != fan);
+            // The two corners other than the fan, in triangle order. Always two, so `top` advances
+            // by a constant and the next scan's bounds and these stores' addresses do not wait on
+            // the corner tests (about 15% faster on a 2k-triangle mesh than pushing a variable
+            // count). A degenerate triangle may push the fan vertex itself, or one corner twice:
+            // the fan vertex is dead whenever the stack is read, and a repeat wins no tie it would
+            // not have won alone, so the order is the same.
+            let [a, b, c] = triangles[t as usize];
+            dead_end[top] = if a == fan { b } else { a };
+            dead_end[top + 1] = if c == fan { b } else { c };
+            top += 2;
+            for v in [a, b, c] {
                 let vertex = &mut vertices[v as usize];
                 vertex.live -= 1;
                 if now - vertex.stamp > *cache {
@@ -153,7 +162,6 @@ impl Fans<'_> {
                     now += 1;
                 }
             }
-            top += pushed;
             if count == last {
                 break;
             }
@@ -187,6 +195,13 @@ fn next_neighbour(candidates: &[u32], vertices: &[Vertex], now: u32, cache: u32)
         // u64: 2·L can exceed u32 on a huge fan; it cannot exceed u64.
         let priority = if u64::from(age) + 2 * u64::from(live) <= u64::from(cache) { i64::from(age) } else { 0 };
         if priority > best_priority {
+            // `cold_path` keeps this a branch rather than a conditional move, so that the next fan
+            // vertex comes from branch prediction and the CPU can start on its fan before this
+            // scan is done; with a conditional move each fan waits for the previous scan's last
+            // candidate. On a 2k-triangle mesh, whose branches the predictor learns when it is
+            // ordered repeatedly, that makes the ordering a quarter faster; on large meshes the
+            // mispredictions cost a few percent.
+            std::hint::cold_path();
             best = v;
             best_priority = priority;
         }
