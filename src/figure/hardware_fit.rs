@@ -112,7 +112,9 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
         fits.len()
     );
     let path = spec.svg_path(&opts.out_dir, opts.quick);
-    let (width, body) = (1300u32, 620u32);
+    // The ranking, then a line per mesh under it; the scatter beside them needs 620 pixels.
+    let lines = 34 + 22 * (TABLE_ROWS as u32 + 1) + 34 + 20 * best.best.len() as u32 + 30;
+    let (width, body) = (1300u32, lines.max(620));
     let header = Header::new(spec, &setup, width);
     let mut names: Vec<String> = Vec::new();
     for (_, _, name) in &best.points {
