@@ -89,25 +89,24 @@ pub fn measure(
     let triangles = mesh.triangles_in_order(order);
     let caches =
         options.caches.iter().map(|&model| (model, cache::simulate(model, &triangles, mesh.vertex_count()))).collect();
-    let gpu_vertices = match options.gpu_vertices {
-        false => None,
-        true => {
-            let counter = vertex_reuse::shared()?;
-            Some(GpuVertices { device: counter.device(), stats: counter.count(&mesh.positions, &triangles)? })
-        }
+    let gpu_vertices = if options.gpu_vertices {
+        let counter = vertex_reuse::shared()?;
+        Some(GpuVertices { device: counter.device(), stats: counter.count(&mesh.positions, &triangles)? })
+    } else {
+        None
     };
-    let cameras = options.views.map(|views| views.cameras(Framing::of(&mesh.positions), options.seed));
-    let overdraw = match (options.views, &cameras) {
-        (Some(views), Some(cameras)) => {
+    let framed = options.views.map(|views| (views, views.cameras(Framing::of(&mesh.positions), options.seed)));
+    let overdraw = match &framed {
+        None => None,
+        Some((views, cameras)) => {
             let per_view = raster.count(&mesh.positions, &triangles, cameras, options.res)?;
             let summary = OverdrawSummary::of(&per_view);
-            Some(Overdraw { views, res: options.res, per_view, summary })
+            Some(Overdraw { views: *views, res: options.res, per_view, summary })
         }
-        _ => None,
     };
     let mut render = Vec::new();
     if !options.render.is_empty() {
-        let cameras = cameras.ok_or_else(|| Error::usage("render timing needs a view set (--views)"))?;
+        let (_, cameras) = framed.ok_or_else(|| Error::usage("render timing needs a view set (--views)"))?;
         let timer = render_time::shared()?;
         for &shading in &options.render {
             let per_view = cameras
