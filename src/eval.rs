@@ -45,6 +45,11 @@ impl RenderTime {
     pub fn mean_ms(&self) -> f64 {
         self.per_view.iter().map(|t| t.median_ms).sum::<f64>() / self.per_view.len().max(1) as f64
     }
+
+    /// Mean over views of the spread of frame times (90th minus 10th percentile), in milliseconds.
+    pub fn spread_ms(&self) -> f64 {
+        self.per_view.iter().map(|t| t.p90_ms - t.p10_ms).sum::<f64>() / self.per_view.len().max(1) as f64
+    }
 }
 
 /// The cache entry, in `--cache` and a spec's `caches`, that counts the GPU's own vertex reuse

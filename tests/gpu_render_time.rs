@@ -55,6 +55,7 @@ fn eval_and_specs_write_render_rows() {
     assert_eq!(render[0]["shading"], "pixel");
     assert_eq!(render[1]["device"], timer.device());
     assert_eq!(render[1]["per_view_ms"].as_array().unwrap().len(), 6);
+    assert!(render[0]["spread_ms"].as_f64().unwrap() >= 0.0);
 
     let root = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(root.path().join("experiments")).unwrap();
@@ -80,14 +81,18 @@ facet = "model"
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
     let csv = triorder::experiment::run(&spec, &options).unwrap();
     let rows = common::csv_rows(&csv);
-    let timed: Vec<_> = rows.iter().filter(|r| r["metric"].starts_with("render_ms")).collect();
-    // 2 models × 2 methods × (1 mean + 6 views).
-    assert_eq!(timed.len(), 28);
+    let timed: Vec<_> = rows.iter().filter(|r| r["metric"].starts_with("render_")).collect();
+    // 2 models × 2 methods × (mean + spread + 6 views).
+    assert_eq!(timed.len(), 32);
+    assert!(timed.iter().all(|r| r["value"].parse::<f64>().unwrap() >= 0.0));
     assert!(timed.iter().all(|r| r["backend"] == format!("gpu: {}", timer.device())));
     assert_eq!(timed.iter().filter(|r| !r["view"].is_empty()).count(), 24);
     // A figure of vertex-bound times needs render = ["vertex"]; rendering needs views.
     let vertex = text.replace("render_ms_pixel_view", "render_ms_vertex");
     std::fs::write(&spec, &vertex).unwrap();
+    let err = triorder::experiment::run(&spec, &options).unwrap_err().to_string();
+    assert!(err.contains("needs render = [\"vertex\"]"), "{err}");
+    std::fs::write(&spec, text.replace("render_ms_pixel_view", "render_spread_vertex")).unwrap();
     let err = triorder::experiment::run(&spec, &options).unwrap_err().to_string();
     assert!(err.contains("needs render = [\"vertex\"]"), "{err}");
 }

@@ -110,7 +110,13 @@ pub fn eval_json(mesh: &Mesh, e: &Evaluation, backend: &str) -> String {
             .iter()
             .map(|r| {
                 let per_view: Vec<f64> = r.per_view.iter().map(|t| t.median_ms).collect();
-                json!({"shading": r.shading.name(), "device": r.device, "mean_ms": r.mean_ms(), "per_view_ms": per_view})
+                json!({
+                    "shading": r.shading.name(),
+                    "device": r.device,
+                    "mean_ms": r.mean_ms(),
+                    "spread_ms": r.spread_ms(),
+                    "per_view_ms": per_view,
+                })
             })
             .collect();
         o.insert("render".into(), Value::Array(render));

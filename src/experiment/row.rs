@@ -85,6 +85,16 @@ pub const METRICS: &[Metric] = &[
         label: "frame time, vertex-bound shader (ms, mean over views)",
         needs: Needs::Views,
     },
+    Metric {
+        name: "render_spread_pixel",
+        label: "frame-time spread p90 − p10, pixel-bound (ms, mean over views)",
+        needs: Needs::Views,
+    },
+    Metric {
+        name: "render_spread_vertex",
+        label: "frame-time spread p90 − p10, vertex-bound (ms, mean over views)",
+        needs: Needs::Views,
+    },
     Metric { name: "render_ms_pixel_view", label: "frame time, pixel-bound shader (ms)", needs: Needs::Views },
     Metric { name: "render_ms_vertex_view", label: "frame time, vertex-bound shader (ms)", needs: Needs::Views },
 ];
@@ -166,12 +176,12 @@ impl Context {
         rows
     }
 
-    /// The render-time rows of one shader: the mean over views, and per view when the figure
-    /// draws them. Each names the device that rendered; `seconds` stays the ordering's time.
+    /// The render-time rows of one shader: the mean over views of the median frame time and of the
+    /// spread (p90 − p10), and the median per view when the figure draws them. Each names the device that rendered; `seconds` stays the ordering's time.
     fn render_rows(&self, base: &Row, overdraw: &Overdraw, render: &RenderTime, rows: &mut Vec<Row>) {
-        let (mean, per_view) = match render.shading {
-            Shading::Pixel => ("render_ms_pixel", "render_ms_pixel_view"),
-            Shading::Vertex => ("render_ms_vertex", "render_ms_vertex_view"),
+        let (mean, spread, per_view) = match render.shading {
+            Shading::Pixel => ("render_ms_pixel", "render_spread_pixel", "render_ms_pixel_view"),
+            Shading::Vertex => ("render_ms_vertex", "render_spread_vertex", "render_ms_vertex_view"),
         };
         let timed = Row {
             views: Some(overdraw.views.to_string()),
@@ -180,6 +190,7 @@ impl Context {
             ..base.clone()
         };
         rows.push(Row { metric: mean, value: render.mean_ms(), ..timed.clone() });
+        rows.push(Row { metric: spread, value: render.spread_ms(), ..timed.clone() });
         for (i, t) in render.per_view.iter().enumerate().filter(|_| self.per_view) {
             rows.push(Row { metric: per_view, view: Some(i), value: t.median_ms, ..timed.clone() });
         }

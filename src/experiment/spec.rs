@@ -422,7 +422,8 @@ impl RawSpec {
             return Err(err(format!("render_frames = {render_frames} is not in 1..={MAX_FRAMES}")));
         }
         for metric in &figure.metrics {
-            let shading = metric.strip_prefix("render_ms_").map(|s| s.trim_end_matches("_view"));
+            let rendered = metric.strip_prefix("render_ms_").or(metric.strip_prefix("render_spread_"));
+            let shading = rendered.map(|s| s.trim_end_matches("_view"));
             if let Some(shading) = shading.and_then(|s| Shading::parse(s).ok())
                 && !render.contains(&shading)
             {
