@@ -1,8 +1,10 @@
 //! The experiment pipeline: spec → results CSV → SVG, checked end to end on procedural meshes in
 //! a temporary project root.
 
+mod common;
+
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use triorder::eval::{MeasureOptions, evaluate};
 use triorder::experiment::row::COLUMNS;
@@ -38,15 +40,6 @@ filter = { cache_kind = "fifo" }
 models = ["sphere:80", "grid:4x4"]
 "#;
 
-/// Writes `text` as `ROOT/experiments/ID.toml` and returns its path.
-fn write_spec(root: &Path, id: &str, text: &str) -> PathBuf {
-    let dir = root.join("experiments");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{id}.toml"));
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 fn quick(root: &Path) -> RunOptions {
     RunOptions { quick: true, out_dir: root.to_path_buf(), ..RunOptions::default() }
 }
@@ -67,7 +60,7 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<HashMap<String, String>>) {
 /// The error `Spec::load` gives for `text` saved as `experiments/ID.toml`.
 fn spec_error(id: &str, text: &str) -> String {
     let root = tempfile::tempdir().unwrap();
-    let path = write_spec(root.path(), id, text);
+    let path = common::write_spec(root.path(), id, text);
     let err = Spec::load(&path).unwrap_err().to_string();
     assert!(err.contains(&path.display().to_string()), "error does not name the file: {err}");
     err
@@ -96,7 +89,7 @@ fn repository_specs_parse() {
 #[test]
 fn grids_expand_to_canonical_methods() {
     let root = tempfile::tempdir().unwrap();
-    let spec = Spec::load(&write_spec(root.path(), "tiny", TINY)).unwrap();
+    let spec = Spec::load(&common::write_spec(root.path(), "tiny", TINY)).unwrap();
     assert_eq!(spec.methods, ["input", "random:seed=1", "random:seed=2"]);
     let caches: Vec<String> = spec.full.caches.iter().map(ToString::to_string).collect();
     assert_eq!(caches, ["fifo:4", "fifo:8", "lru:16"]);
@@ -173,7 +166,7 @@ modles = ["a"]"#,
     let fit = TINY.replace("kind = \"line\"", "kind = \"hardware-fit\"").replace("x = \"cache_size\"\n", "");
     assert!(spec_error("tiny", &fit).contains("caches must list simulated models and `gpu`"));
     let counted = fit.replace(r#"caches = ["fifo:4..8/4", "lru:16"]"#, r#"caches = ["gpu", "fifo:4..8/4"]"#);
-    let spec = Spec::load(&write_spec(tempfile::tempdir().unwrap().path(), "tiny", &counted)).unwrap();
+    let spec = Spec::load(&common::write_spec(tempfile::tempdir().unwrap().path(), "tiny", &counted)).unwrap();
     assert!(spec.full.gpu_vertices && spec.full.caches.len() == 2);
     let with_x = counted.replace("metric = \"acmr\"", "metric = \"acmr\"\nx = \"cache_size\"");
     assert!(spec_error("tiny", &with_x).contains("figure.x is not used by kind = \"hardware-fit\""));
@@ -184,7 +177,7 @@ modles = ["a"]"#,
 #[test]
 fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
     let root = tempfile::tempdir().unwrap();
-    let spec_path = write_spec(root.path(), "tiny", TINY);
+    let spec_path = common::write_spec(root.path(), "tiny", TINY);
     let csv = run(&spec_path, &quick(root.path())).unwrap();
     assert_eq!(csv, root.path().join("results/quick/tiny.csv"));
     let (header, rows) = read_csv(&csv);
@@ -270,7 +263,7 @@ fn per_view_rows_are_written_when_the_figure_draws_them() {
         "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
         "kind = \"distribution\"\nmetric = \"ovr\"\nfacet = \"model\"",
     );
-    let path = write_spec(root.path(), "spread", &text);
+    let path = common::write_spec(root.path(), "spread", &text);
     let (_, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
     let spec = Spec::load(&path).unwrap();
     let work = spec.workload(true).unwrap();
@@ -332,7 +325,7 @@ fn every_figure_kind_draws_from_one_csv() {
             "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
             figure,
         );
-        let path = write_spec(root.path(), id, &text);
+        let path = common::write_spec(root.path(), id, &text);
         run(&path, &quick(root.path())).unwrap();
         let svg = std::fs::read_to_string(plot(&path, &plot_quick(root.path())).unwrap()).unwrap();
         assert!(svg.contains(want), "{id}: SVG lacks `{want}`");
@@ -342,7 +335,7 @@ fn every_figure_kind_draws_from_one_csv() {
 #[test]
 fn plotting_without_results_or_with_unusable_results_says_why() {
     let root = tempfile::tempdir().unwrap();
-    let path = write_spec(root.path(), "tiny", TINY);
+    let path = common::write_spec(root.path(), "tiny", TINY);
     let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
     assert!(err.contains("results/quick/tiny.csv") && err.contains("run the experiment first"), "{err}");
     assert!(!root.path().join("paper-figures").exists());
@@ -369,7 +362,7 @@ fn missing_models_are_refused_before_any_work() {
     let root = tempfile::tempdir().unwrap();
     let text =
         TINY.replacen("models = [\"sphere:80\", \"grid:4x4\"]", "models = [\"sphere:80\", \"models/nowhere.ply\"]", 1);
-    let path = write_spec(root.path(), "tiny", &text);
+    let path = common::write_spec(root.path(), "tiny", &text);
     let opts = RunOptions {
         data: Some(root.path().join("data")),
         ..RunOptions { out_dir: root.path().into(), ..RunOptions::default() }
@@ -388,7 +381,7 @@ fn missing_models_are_refused_before_any_work() {
 #[test]
 fn a_failed_run_leaves_the_previous_results_whole() {
     let root = tempfile::tempdir().unwrap();
-    let path = write_spec(root.path(), "tiny", TINY);
+    let path = common::write_spec(root.path(), "tiny", TINY);
     let opts = RunOptions { out_dir: root.path().into(), ..RunOptions::default() };
     let csv = run(&path, &opts).unwrap();
     assert_eq!(csv, root.path().join("results/tiny.csv"));
@@ -408,8 +401,8 @@ fn a_failed_run_leaves_the_previous_results_whole() {
 #[test]
 fn reproduce_runs_and_plots_every_matching_spec_in_order() {
     let root = tempfile::tempdir().unwrap();
-    write_spec(root.path(), "tiny", TINY);
-    write_spec(root.path(), "another", &TINY.replace("id = \"tiny\"", "id = \"another\""));
+    common::write_spec(root.path(), "tiny", TINY);
+    common::write_spec(root.path(), "another", &TINY.replace("id = \"tiny\"", "id = \"another\""));
     let outputs = reproduce(&quick(root.path()), None).unwrap();
     let ids: Vec<_> = outputs.iter().map(|(csv, _)| csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
     assert_eq!(ids, ["another", "tiny"]);
@@ -418,7 +411,7 @@ fn reproduce_runs_and_plots_every_matching_spec_in_order() {
     let err = reproduce(&quick(root.path()), Some("nothing")).unwrap_err().to_string();
     assert!(err.contains("matching `nothing`"), "{err}");
     // A broken spec stops everything before any run.
-    write_spec(
+    common::write_spec(
         root.path(),
         "broken",
         &TINY.replace("id = \"tiny\"", "id = \"broken\"").replace("\"input\"", "\"nope\""),
@@ -435,7 +428,7 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
         "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
         "kind = \"corners\"\nmetric = \"acmr\"",
     );
-    let path = write_spec(root.path(), "corners", &text);
+    let path = common::write_spec(root.path(), "corners", &text);
     run(&path, &quick(root.path())).unwrap();
     let orders = root.path().join("results/quick/corners.orders.csv");
     let (header, rows) = read_csv(&orders);
@@ -507,7 +500,7 @@ models = ["assets/Fox.glb#frames=2", "sphere:80"]
 #[test]
 fn animated_runs_write_buffers_and_a_row_per_clip() {
     let root = tempfile::tempdir().unwrap();
-    let path = write_spec(root.path(), "animated", ANIMATED);
+    let path = common::write_spec(root.path(), "animated", ANIMATED);
     let (header, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
     assert_eq!(header, COLUMNS);
     let find = |model: &str, method: &str, metric: &str, clip: &str| {
@@ -569,7 +562,11 @@ fn animated_specs_are_checked_before_any_work() {
     }
     // A clip the file does not have fails the run before anything is ordered or written.
     let root = tempfile::tempdir().unwrap();
-    let path = write_spec(root.path(), "animated", &ANIMATED.replace("#frames=2\", \"sphere", "#clip=Fly\", \"sphere"));
+    let path = common::write_spec(
+        root.path(),
+        "animated",
+        &ANIMATED.replace("#frames=2\", \"sphere", "#clip=Fly\", \"sphere"),
+    );
     let err = run(&path, &quick(root.path())).unwrap_err().to_string();
     for want in [path.display().to_string().as_str(), "quick.models[0]", "Fly", "Survey"] {
         assert!(err.contains(want), "error lacks `{want}`: {err}");

@@ -112,10 +112,9 @@ fn eval_names_the_device_and_matches_the_cpu() {
 fn a_spec_runs_on_the_gpu_and_its_rows_name_the_device() {
     let Some(gpu) = common::gpu() else { return };
     let root = tempfile::tempdir().unwrap();
-    std::fs::create_dir_all(root.path().join("experiments")).unwrap();
-    let spec = root.path().join("experiments/tiny-gpu.toml");
-    std::fs::write(
-        &spec,
+    let spec = common::write_spec(
+        root.path(),
+        "tiny-gpu",
         r#"id = "tiny-gpu"
 title = "GPU smoke"
 question = "Does a spec run on the GPU backend?"
@@ -129,8 +128,7 @@ kind = "bar"
 metric = "ovr_mean"
 x = "method"
 "#,
-    )
-    .unwrap();
+    );
     let read = |backend: &str| {
         let options = triorder::experiment::RunOptions {
             out_dir: root.path().into(),

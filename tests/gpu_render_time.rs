@@ -11,14 +11,7 @@ use triorder::raster::{Framing, ViewSet};
 
 fn timer() -> Option<&'static RenderTimer> {
     common::gpu()?;
-    match render_time::shared() {
-        Ok(timer) => Some(timer),
-        Err(e) if std::env::var_os("TRIORDER_REQUIRE_GPU").is_some() => panic!("TRIORDER_REQUIRE_GPU is set: {e}"),
-        Err(e) => {
-            eprintln!("note: skipping: {e}");
-            None
-        }
-    }
+    common::available(render_time::shared())
 }
 
 #[test]
@@ -58,8 +51,6 @@ fn eval_and_specs_write_render_rows() {
     assert!(render[0]["spread_ms"].as_f64().unwrap() >= 0.0);
 
     let root = tempfile::tempdir().unwrap();
-    std::fs::create_dir_all(root.path().join("experiments")).unwrap();
-    let spec = root.path().join("experiments/tiny-time.toml");
     let text = r#"id = "tiny-time"
 title = "Render time smoke"
 question = "Do render times land in the CSV?"
@@ -77,7 +68,7 @@ x = "view"
 series = "method_name"
 facet = "model"
 "#;
-    std::fs::write(&spec, text).unwrap();
+    let spec = common::write_spec(root.path(), "tiny-time", text);
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
     let csv = triorder::experiment::run(&spec, &options).unwrap();
     let rows = common::csv_rows(&csv);

@@ -15,14 +15,7 @@ use triorder::topology::Topology;
 
 fn counter() -> Option<&'static VertexCounter> {
     common::gpu()?;
-    match vertex_reuse::shared() {
-        Ok(counter) => Some(counter),
-        Err(e) if std::env::var_os("TRIORDER_REQUIRE_GPU").is_some() => panic!("TRIORDER_REQUIRE_GPU is set: {e}"),
-        Err(e) => {
-            eprintln!("note: skipping: {e}");
-            None
-        }
-    }
+    common::available(vertex_reuse::shared())
 }
 
 #[test]
@@ -80,8 +73,6 @@ fn eval_and_specs_write_counted_rows() {
     assert!(json["gpu_vertices"]["invocations"].as_u64().unwrap() >= 3225);
 
     let root = tempfile::tempdir().unwrap();
-    std::fs::create_dir_all(root.path().join("experiments")).unwrap();
-    let spec = root.path().join("experiments/tiny-hw.toml");
     let text = r#"id = "tiny-hw"
 title = "Hardware reuse smoke"
 question = "Do counted rows land beside simulated ones?"
@@ -94,7 +85,7 @@ metric = "acmr"
 x = "method"
 series = "cache"
 "#;
-    std::fs::write(&spec, text).unwrap();
+    let spec = common::write_spec(root.path(), "tiny-hw", text);
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
     let csv = triorder::experiment::run(&spec, &options).unwrap();
     let rows = common::csv_rows(&csv);

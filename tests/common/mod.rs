@@ -47,15 +47,28 @@ pub fn real_mesh(name: &str) -> Option<Mesh> {
 /// lavapipe) a missing adapter fails the test instead of skipping it.
 pub fn gpu() -> Option<&'static triorder::raster::gpu::GpuRaster> {
     static GPU: std::sync::OnceLock<Option<triorder::raster::gpu::GpuRaster>> = std::sync::OnceLock::new();
-    GPU.get_or_init(|| match triorder::raster::gpu::GpuRaster::new() {
-        Ok(gpu) => Some(gpu),
+    GPU.get_or_init(|| available(triorder::raster::gpu::GpuRaster::new())).as_ref()
+}
+
+/// A GPU part that opened, or `None` with a notice; a failure with `TRIORDER_REQUIRE_GPU` set.
+pub fn available<T>(opened: triorder::Result<T>) -> Option<T> {
+    match opened {
+        Ok(part) => Some(part),
         Err(e) if std::env::var_os("TRIORDER_REQUIRE_GPU").is_some() => panic!("TRIORDER_REQUIRE_GPU is set: {e}"),
         Err(e) => {
-            eprintln!("note: skipping the GPU backend: {e}");
+            eprintln!("note: skipping a GPU test: {e}");
             None
         }
-    })
-    .as_ref()
+    }
+}
+
+/// Writes `text` as `ROOT/experiments/ID.toml` and returns its path.
+pub fn write_spec(root: &std::path::Path, id: &str, text: &str) -> std::path::PathBuf {
+    let dir = root.join("experiments");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{id}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
 }
 
 /// Every raster backend this machine can run: the CPU reference, then the GPU when there is one.
