@@ -15,7 +15,7 @@
 //!   in f32. The depth buffer is cleared to 1.0 per view; a fragment passes when z < stored (LESS),
 //!   in draw order, and then writes its depth.
 //!
-//! Per view it counts covered pixels, rasterized fragments and fragments that pass the depth test.
+//! Per view it counts covered pixels and fragments that pass the depth test.
 //! Views run in parallel (rayon), each with its own depth buffer.
 
 use glam::Vec3;
@@ -224,7 +224,6 @@ fn draw(
             let zy = a.z + dzdy * (y as f32 + 0.5 - ay);
             for x in x0..=x1 {
                 if (e0 | e1 | e2) >= 0 {
-                    counts.fragments += 1;
                     let z = zy + dzdx * (x as f32 + 0.5 - ax);
                     let d = &mut depth[row + x as usize];
                     let passed = z < *d;

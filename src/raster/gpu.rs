@@ -1,20 +1,13 @@
 //! The GPU raster backend: the same per-view counts as [`super::cpu::CpuRaster`], drawn by a real
-//! Vulkan device through wgpu and counted by occlusion queries and a fragment-shader counter.
+//! Vulkan device through wgpu and counted by occlusion queries.
 //!
-//! Per view, in one render pass over an R×R `Depth32Float` buffer cleared to 1.0, two draws:
+//! Per view, in one render pass over an R×R `Depth32Float` buffer cleared to 1.0, two draws
+//! without a fragment shader (depth only, the cheapest path on every device):
 //! 1. The mesh in draw order, back faces culled (counter-clockwise is front, NDC y up, as on the
 //!    CPU), depth test LESS with writes. An occlusion query counts the samples that pass:
-//!    **passed**. The fragment shader adds one to an atomic counter for the view: because it
-//!    writes to memory, Vulkan runs it before the depth test, for every rasterized fragment, so
-//!    the counter is **fragments** (GPU.md: exact on lavapipe and on an H100). The counter is
-//!    spread over [`LANES`] words, a 64-byte line per 64×64-pixel tile (16 lines, by tile) and a
-//!    word per column within it, so fragments do not all contend for one address, threads
-//!    drawing different tiles rarely share a line, and no word can overflow.
+//!    **passed**.
 //! 2. A full-screen triangle at depth 1.0 tested GREATER without writes, which passes exactly
 //!    where some fragment left a depth below 1.0: **covered**, by a second query.
-//!
-//! One mesh draw per view, not two: drawing is what costs (lavapipe spends it in vertex
-//! processing and triangle setup, which it runs on one thread).
 //!
 //! The rules the CPU reference spells out (pixel centres, top-left rule, LESS, clear to 1.0) are
 //! Vulkan's own; the CPU snaps to 8 sub-pixel bits as Vulkan devices do. What can still differ is below the rules:
@@ -24,10 +17,12 @@
 //!
 //! Vulkan only promises that an occlusion query is zero or not, and wgpu does not ask for precise
 //! counts; every driver we met (lavapipe, NVIDIA) counts exactly anyway. [`GpuRaster::new`] draws a
-//! calibration scene whose counts are known and refuses a driver that does not.
+//! calibration scene whose counts are known on every device and refuses a driver that does not.
 //!
 //! Views go in batches of [`BATCH`]: one submission, one uniform buffer of matrices addressed by
-//! dynamic offset, one query resolve and one readback per batch.
+//! dynamic offset, one query resolve and one readback per batch. The views are split over the
+//! devices of [`gpu::pool`], a thread each: one device on a hardware GPU, one per core on a
+//! software one, whose drawing is single-threaded per device.
 
 use glam::{Mat4, Vec3};
 
@@ -37,35 +32,19 @@ use super::{RasterBackend, ViewCounts};
 use crate::error::{Error, Result};
 use crate::gpu::{self, Gpu};
 
-/// Views per submission: two occlusion queries each, under wgpu's 4,096 per query set.
-const BATCH: usize = 1024;
+/// Views per submission: two occlusion queries each, within wgpu's 4,096 per query set.
+const BATCH: usize = 4096 / QUERIES_PER_VIEW;
 const QUERIES_PER_VIEW: usize = 2;
-/// Counter words per view for the fragment count (see the module comment).
-const LANES: usize = 256;
-/// Bytes per view in the uniform buffer: the matrix, then the view's first counter word.
-const VIEW_BYTES: u64 = 80;
+/// Bytes per view in the uniform buffer: its matrix.
+const VIEW_BYTES: u64 = 64;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 const SHADER: &str = r#"
-struct View {
-    view_proj: mat4x4<f32>,
-    first_counter: u32,
-}
-@group(0) @binding(0) var<uniform> view: View;
-@group(0) @binding(1) var<storage, read_write> fragments: array<atomic<u32>>;
+@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
 
 @vertex
 fn mesh(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return view.view_proj * vec4<f32>(position, 1.0);
-}
-
-// Runs for every rasterized fragment: a shader that writes memory gets late depth testing.
-@fragment
-fn count(@builtin(position) pixel: vec4<f32>) {
-    let x = u32(pixel.x);
-    let y = u32(pixel.y);
-    let lane = ((x / 64u + 8u * (y / 64u)) % 16u) * 16u + x % 16u;
-    atomicAdd(&fragments[view.first_counter + lane], 1u);
+    return view_proj * vec4<f32>(position, 1.0);
 }
 
 // One triangle covering the whole image, at the far plane.
@@ -77,6 +56,12 @@ fn fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 
 /// Overdraw counts from the GPU.
 pub struct GpuRaster {
+    /// One per device of [`gpu::pool`], each checked by calibration.
+    devices: Vec<DeviceRaster>,
+}
+
+/// The pipelines on one device.
+struct DeviceRaster {
     gpu: &'static Gpu,
     layout: wgpu::BindGroupLayout,
     passed: wgpu::RenderPipeline,
@@ -84,16 +69,28 @@ pub struct GpuRaster {
 }
 
 impl GpuRaster {
-    /// Opens the GPU, builds the three pipelines and checks on a calibration scene that the
-    /// driver's occlusion queries count every sample.
+    /// Opens the GPU's devices, builds the pipelines on each and checks on a calibration scene
+    /// that the driver's occlusion queries count every sample.
     pub fn new() -> Result<GpuRaster> {
-        let gpu = gpu::shared()?;
-        let raster = gpu.checked("building the raster pipelines", || Ok(GpuRaster::build(gpu)))?;
-        raster.calibrate()?;
-        Ok(raster)
+        let devices = gpu::pool()?
+            .into_iter()
+            .map(|gpu| {
+                let raster = gpu.checked("building the raster pipelines", || Ok(DeviceRaster::build(gpu)))?;
+                raster.calibrate()?;
+                Ok(raster)
+            })
+            .collect::<Result<_>>()?;
+        Ok(GpuRaster { devices })
     }
 
-    fn build(gpu: &'static Gpu) -> GpuRaster {
+    /// The device's name and driver, for provenance.
+    pub fn device(&self) -> String {
+        self.devices[0].gpu.describe()
+    }
+}
+
+impl DeviceRaster {
+    fn build(gpu: &'static Gpu) -> DeviceRaster {
         let device = &gpu.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("overdraw"),
@@ -101,28 +98,16 @@ impl GpuRaster {
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("view"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(VIEW_BYTES),
-                    },
-                    count: None,
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(VIEW_BYTES),
                 },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
+                count: None,
+            }],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("overdraw"),
@@ -158,18 +143,13 @@ impl GpuRaster {
                     bias: Default::default(),
                 }),
                 multisample: Default::default(),
-                // No colour target: the mesh's fragment shader only counts.
-                fragment: mesh.then(|| wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("count"),
-                    compilation_options: Default::default(),
-                    targets: &[],
-                }),
+                // Depth only: the queries count what passes the depth test.
+                fragment: None,
                 multiview_mask: None,
                 cache: None,
             })
         };
-        GpuRaster {
+        DeviceRaster {
             gpu,
             passed: pipeline("mesh", true, wgpu::CompareFunction::Less, true),
             covered: pipeline("fullscreen", false, wgpu::CompareFunction::Greater, false),
@@ -177,14 +157,9 @@ impl GpuRaster {
         }
     }
 
-    /// The device's name and driver, for provenance.
-    pub fn device(&self) -> String {
-        self.gpu.describe()
-    }
-
     /// Draws a square filling the image twice at the same depth: the second copy fails LESS, so
-    /// exact queries give passed = covered = R², fragments = 2R². A driver answering "some" (1)
-    /// instead of a count is refused here, before it can produce a wrong figure.
+    /// exact queries give passed = covered = R². A driver answering "some" (1) instead of a
+    /// count is refused here, before it can produce a wrong figure.
     fn calibrate(&self) -> Result<()> {
         let res = 64;
         let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
@@ -193,45 +168,66 @@ impl GpuRaster {
         let camera = Camera { view_proj: Mat4::IDENTITY, eye: Vec3::Z, forward: Vec3::NEG_Z, perspective: false };
         let counts = self.count(&positions, &[quad, quad].concat(), &[camera], res)?;
         let area = u64::from(res * res);
-        let expected = ViewCounts { covered: area, fragments: 2 * area, passed: area };
+        let expected = ViewCounts { covered: area, passed: area };
         if counts[0] != expected {
             return Err(Error::Gpu(format!(
                 "{}: occlusion queries are not exact on this driver (calibration counted {:?}, expected {expected:?})",
-                self.device(),
+                self.gpu.describe(),
                 counts[0]
             )));
         }
         Ok(())
     }
 
+    /// Uploads the mesh and counts `cameras` on this device, a batch per submission.
+    fn count(
+        &self,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        cameras: &[Camera],
+        res: u32,
+    ) -> Result<Vec<ViewCounts>> {
+        self.gpu.checked("counting fragments", || {
+            let (vertices, index, index_count) = self.gpu.mesh_buffers(bytemuck::cast_slice(positions), triangles)?;
+            let depth = self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("depth"),
+                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            let depth = depth.create_view(&Default::default());
+            let mesh = Mesh { vertices: &vertices, index: &index, index_count, depth: &depth };
+            let mut counts = Vec::with_capacity(cameras.len());
+            for batch in cameras.chunks(BATCH) {
+                counts.extend(self.draw_batch(&mesh, batch)?);
+            }
+            Ok(counts)
+        })
+    }
+
     fn draw_batch(&self, mesh: &Mesh, cameras: &[Camera]) -> Result<Vec<ViewCounts>> {
         let device = &self.gpu.device;
         let stride = VIEW_BYTES.next_multiple_of(u64::from(device.limits().min_uniform_buffer_offset_alignment));
         let mut uniforms = vec![0u8; stride as usize * cameras.len()];
-        for (v, (slot, camera)) in uniforms.chunks_exact_mut(stride as usize).zip(cameras).enumerate() {
+        for (slot, camera) in uniforms.chunks_exact_mut(stride as usize).zip(cameras) {
             slot[..64].copy_from_slice(bytemuck::cast_slice(&camera.view_proj.to_cols_array()));
-            slot[64..68].copy_from_slice(&((v * LANES) as u32).to_le_bytes());
         }
         let uniforms = self.gpu.buffer_init("views", &uniforms, wgpu::BufferUsages::UNIFORM)?;
-        let counters = self.gpu.buffer_init(
-            "fragment counters",
-            &vec![0u8; cameras.len() * LANES * 4],
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        )?;
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("view"),
             layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &uniforms,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(VIEW_BYTES),
-                    }),
-                },
-                wgpu::BindGroupEntry { binding: 1, resource: counters.as_entire_binding() },
-            ],
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniforms,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(VIEW_BYTES),
+                }),
+            }],
         });
         let queries = (cameras.len() * QUERIES_PER_VIEW) as u32;
         let query_set = device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -273,22 +269,13 @@ impl GpuRaster {
             mapped_at_creation: false,
         });
         encoder.resolve_query_set(&query_set, 0..queries, &resolved, 0);
-        let [queries, fragments]: [Vec<u8>; 2] = self
+        let [queries]: [Vec<u8>; 1] = self
             .gpu
-            .read_back(encoder, &[&resolved, &counters])?
+            .read_back(encoder, &[&resolved])?
             .try_into()
             .map_err(|_| Error::Gpu("readback returned the wrong number of buffers".into()))?;
         let queries: Vec<u64> = bytemuck::pod_collect_to_vec(&queries);
-        let fragments: Vec<u32> = bytemuck::pod_collect_to_vec(&fragments);
-        Ok(queries
-            .chunks_exact(QUERIES_PER_VIEW)
-            .zip(fragments.chunks_exact(LANES))
-            .map(|(q, lanes)| ViewCounts {
-                passed: q[0],
-                covered: q[1],
-                fragments: lanes.iter().map(|&n| u64::from(n)).sum(),
-            })
-            .collect())
+        Ok(queries.chunks_exact(QUERIES_PER_VIEW).map(|q| ViewCounts { passed: q[0], covered: q[1] }).collect())
     }
 }
 
@@ -309,6 +296,8 @@ impl RasterBackend for GpuRaster {
         format!("gpu: {}", self.device())
     }
 
+    /// Splits the views into one contiguous share per device, drawn in parallel, concatenated
+    /// back in order.
     fn count(
         &self,
         positions: &[Vec3],
@@ -316,31 +305,23 @@ impl RasterBackend for GpuRaster {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>> {
-        let limit = self.gpu.device.limits().max_texture_dimension_2d.min(MAX_RESOLUTION);
+        let first = &self.devices[0];
+        let limit = first.gpu.device.limits().max_texture_dimension_2d.min(MAX_RESOLUTION);
         if !(1..=limit).contains(&res) {
             return Err(Error::usage(format!("resolution {res} is outside 1..={limit} ({})", self.device())));
         }
         check_projection(positions, cameras, res)?;
-        if cameras.is_empty() {
-            return Ok(Vec::new());
+        let share = cameras.len().div_ceil(self.devices.len()).max(1);
+        if share == cameras.len() {
+            return first.count(positions, triangles, cameras, res);
         }
-        self.gpu.checked("counting fragments", || {
-            let (vertices, index, index_count) = self.gpu.mesh_buffers(bytemuck::cast_slice(positions), triangles)?;
-            let depth = self.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("depth"),
-                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: DEPTH,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            });
-            let depth = depth.create_view(&Default::default());
-            let mesh = Mesh { vertices: &vertices, index: &index, index_count, depth: &depth };
+        std::thread::scope(|scope| {
+            let parts: Vec<_> = (self.devices.iter().zip(cameras.chunks(share)))
+                .map(|(device, views)| scope.spawn(move || device.count(positions, triangles, views, res)))
+                .collect();
             let mut counts = Vec::with_capacity(cameras.len());
-            for batch in cameras.chunks(BATCH) {
-                counts.extend(self.draw_batch(&mesh, batch)?);
+            for part in parts {
+                counts.extend(part.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))?);
             }
             Ok(counts)
         })

@@ -15,8 +15,6 @@ pub use views::{Camera, Framing, ViewSet};
 pub struct ViewCounts {
     /// Pixels with at least one front-facing fragment (the projected area of the mesh).
     pub covered: u64,
-    /// Front-facing fragments rasterized (depth complexity, independent of order).
-    pub fragments: u64,
     /// Fragments that passed the depth test, i.e. were shaded with early-Z: depends on order.
     pub passed: u64,
 }
