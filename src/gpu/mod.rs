@@ -198,6 +198,44 @@ impl Gpu {
         Ok(out)
     }
 
+    /// The WGSL module `source`.
+    pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
+        self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
+    }
+
+    /// The layouts of a pipeline whose only binding is one uniform buffer of `bytes` at group 0,
+    /// binding 0, seen by `visibility`; `dynamic` when each draw picks its slot by offset.
+    pub fn uniform_layouts(
+        &self,
+        label: &str,
+        visibility: wgpu::ShaderStages,
+        bytes: u64,
+        dynamic: bool,
+    ) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+        let group = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: dynamic,
+                    min_binding_size: wgpu::BufferSize::new(bytes),
+                },
+                count: None,
+            }],
+        });
+        let pipeline = self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&group)],
+            immediate_size: 0,
+        });
+        (group, pipeline)
+    }
+
     /// The vertex buffer of `vertices` (floats, interleaved as the pipeline reads them) and the
     /// index buffer of `triangles`, with the index count.
     pub fn mesh_buffers(&self, vertices: &[f32], triangles: &[[u32; 3]]) -> Result<(wgpu::Buffer, wgpu::Buffer, u32)> {

@@ -52,10 +52,7 @@ impl VertexCounter {
 
     fn build(gpu: &'static Gpu) -> VertexCounter {
         let device = &gpu.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("vertex count"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-        });
+        let module = gpu.shader("vertex count", SHADER);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("vertex count"),
             bind_group_layouts: &[],
