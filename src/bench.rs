@@ -102,14 +102,24 @@ pub struct BackendRow {
 
 /// Times overdraw counting of `mesh` (in meshoptimizer's vertex-cache order) over `views` at
 /// `res` on the CPU reference and on `gpu`, taking turns. The GPU time includes what a caller
-/// pays: uploading the mesh, drawing, reading the counts back.
-pub fn compare_backends(mesh: &Mesh, gpu: &dyn RasterBackend, views: ViewSet, res: u32, reps: usize) -> BackendRow {
+/// pays: uploading the mesh, drawing, reading the counts back. Each backend counts once before
+/// the timing, so one that refuses the mesh fails here instead of being timed failing.
+pub fn compare_backends(
+    mesh: &Mesh,
+    gpu: &dyn RasterBackend,
+    views: ViewSet,
+    res: u32,
+    reps: usize,
+) -> crate::Result<BackendRow> {
     let indices = meshopt::optimize_vertex_cache(&peer::index_buffer(mesh), mesh.vertex_count());
     let triangles: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let cameras = views.cameras(Framing::of(&mesh.positions), 0);
+    for backend in [&CpuRaster as &dyn RasterBackend, gpu] {
+        backend.count(&mesh.positions, &triangles, &cameras, res)?;
+    }
     let run = |backend: &dyn RasterBackend| black_box(backend.count(&mesh.positions, &triangles, &cameras, res).ok());
     let [cpu_seconds, gpu_seconds] = median_interleaved(reps, [&mut || drop(run(&CpuRaster)), &mut || drop(run(gpu))]);
-    BackendRow {
+    Ok(BackendRow {
         mesh: mesh.name.clone(),
         triangles: mesh.triangle_count(),
         views,
@@ -117,7 +127,7 @@ pub fn compare_backends(mesh: &Mesh, gpu: &dyn RasterBackend, views: ViewSet, re
         cpu_seconds,
         gpu_seconds,
         device: gpu.describe(),
-    }
+    })
 }
 
 /// Times every comparison on `mesh`, drawn in meshoptimizer's vertex-cache order (the realistic

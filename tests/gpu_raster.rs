@@ -169,3 +169,15 @@ x = "method"
     assert!(!ovr(&cpu).is_empty());
     assert_eq!(ovr(&cpu), ovr(&on_gpu));
 }
+
+/// The backend benchmark times only work that succeeds: a resolution both backends refuse is an
+/// error, not a row of timed failures.
+#[test]
+fn the_backend_benchmark_refuses_what_it_cannot_count() {
+    let Some(gpu) = common::gpu() else { return };
+    let spot = load::load_file(std::path::Path::new("assets/spot.obj")).unwrap();
+    let row = triorder::bench::compare_backends(&spot, gpu, ViewSet::Ico(12), 64, 1).unwrap();
+    assert!(row.cpu_seconds > 0.0 && row.gpu_seconds > 0.0, "{row:?}");
+    let refused = triorder::bench::compare_backends(&spot, gpu, ViewSet::Ico(12), 20_000, 1);
+    assert!(refused.unwrap_err().to_string().contains("resolution"));
+}

@@ -62,7 +62,7 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
             "mesh", "triangles", "views", "cpu ms", "gpu ms", "ratio"
         );
         for (model, mesh) in &meshes {
-            let r = triorder::bench::compare_backends(mesh, gpu.as_ref(), raster::ViewSet::Ico(162), 512, reps);
+            let r = triorder::bench::compare_backends(mesh, gpu.as_ref(), raster::ViewSet::Ico(162), 512, reps)?;
             println!(
                 "{:<28} {:>9}  {:<14} {:>10.1} {:>10.1} {:>7.2}x  {}",
                 model,
