@@ -38,6 +38,13 @@ pub fn shared() -> Result<&'static Gpu> {
     once(&GPU, Gpu::open)
 }
 
+/// The vertex layout of [`Gpu::mesh_buffers`] given bare positions: three floats at location 0.
+pub const POSITIONS: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 12,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+};
+
 /// At most this many devices in a software [`pool`]: each brings its own rasterizer threads.
 const MAX_SOFTWARE_DEVICES: usize = 8;
 

@@ -65,11 +65,7 @@ impl VertexCounter {
                 module: &module,
                 entry_point: Some("main"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 12,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-                })],
+                buffers: &[Some(super::POSITIONS)],
             },
             primitive: Default::default(),
             depth_stencil: Some(wgpu::DepthStencilState {

@@ -94,13 +94,8 @@ impl DeviceRaster {
         let device = &gpu.device;
         let module = gpu.shader("overdraw", SHADER);
         let (layout, pipeline_layout) = gpu.uniform_layouts("view", wgpu::ShaderStages::VERTEX, VIEW_BYTES, true);
-        let positions = wgpu::VertexBufferLayout {
-            array_stride: 12,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-        };
         let pipeline = |entry: &str, mesh: bool, compare: wgpu::CompareFunction, write: bool| {
-            let buffers = [Some(positions.clone())];
+            let buffers = [Some(gpu::POSITIONS)];
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&pipeline_layout),
