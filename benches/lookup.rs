@@ -9,7 +9,7 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use triorder::order::per_node::Lookup;
+use triorder::order::Lookup;
 use triorder::raster::views::icosphere_directions;
 
 const FRAMES: usize = 30;

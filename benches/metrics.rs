@@ -8,21 +8,20 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use triorder::mesh::{Mesh, source};
-use triorder::metrics::cache::{CacheModel, simulate};
-use triorder::peer;
-use triorder::raster::{Framing, RasterBackend, ViewSet, cpu::CpuRaster};
+use triorder::measure::cache::{CacheModel, simulate};
+use triorder::mesh::Framing;
+use triorder::mesh::{Mesh, Source, source};
+use triorder::raster::{RasterBackend, ViewSet, cpu::CpuRaster};
 
 fn mesh() -> Mesh {
     let data = source::data_dir(None).or_else(|| Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")));
-    source::open("models/bun_zipper.ply", data.as_deref(), 0)
-        .or_else(|_| source::open("sphere:70000", None, 0))
-        .expect("a benchmark mesh")
+    let open = |name: &str| Source::parse(name)?.mesh(data.as_deref(), 0);
+    open("models/bun_zipper.ply").or_else(|_| open("sphere:70000")).expect("a benchmark mesh")
 }
 
 fn benches(c: &mut Criterion) {
     let mesh = mesh();
-    let indices = meshopt::optimize_vertex_cache(&peer::index_buffer(&mesh), mesh.vertex_count());
+    let indices = meshopt::optimize_vertex_cache(&mesh.index_buffer(), mesh.vertex_count());
     let triangles: Vec<[u32; 3]> = indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
     let n = mesh.vertex_count();
 
@@ -45,7 +44,7 @@ fn benches(c: &mut Criterion) {
     group.bench_function("triorder axis6@256", |b| {
         b.iter(|| CpuRaster.count(&mesh.positions, black_box(&triangles), &cameras, 256).unwrap())
     });
-    let adapter = peer::positions(&mesh);
+    let adapter = mesh.meshopt_positions();
     group.bench_function("meshopt analyzeOverdraw (6 views@256)", |b| {
         b.iter(|| meshopt::analyze_overdraw(black_box(&indices), &adapter))
     });

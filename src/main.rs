@@ -148,6 +148,8 @@ enum Command {
         /// Plot the quick run's CSV into paper-figures/quick/.
         #[arg(long)]
         quick: bool,
+        #[command(flatten)]
+        common: Common,
     },
     /// Run and plot every experiment in experiments/.
     Reproduce {
@@ -191,7 +193,7 @@ fn main() -> ExitCode {
             commands::eval(&mesh, &methods, &measure, &animation, json, &common)
         }
         Command::Run { spec, quick, backend, common } => commands::run(&spec, quick, backend, &common),
-        Command::Plot { spec, quick } => commands::plot(&spec, quick),
+        Command::Plot { spec, quick, common } => commands::plot(&spec, quick, &common),
         Command::Reproduce { quick, only, backend, common } => {
             commands::reproduce(quick, only.as_deref(), backend, &common)
         }

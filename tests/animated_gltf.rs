@@ -10,11 +10,11 @@ use base64::Engine;
 use glam::Vec3;
 use serde_json::{Value, json};
 use triorder::mesh::animated::{Animated, Pose};
-use triorder::mesh::gltf_animation::{ClipSelection, read_animated, read_with_rest_pose};
+use triorder::mesh::gltf::animation::{ClipSelection, read_animated, read_with_rest_pose};
 use triorder::mesh::load::load_file;
 
-fn animated_file(name: &str) -> Option<PathBuf> {
-    Some(common::data_dir()?.join("animated").join(name))
+fn animated_file(name: &str) -> PathBuf {
+    common::animated_file(name)
 }
 
 fn all_clips() -> ClipSelection {
@@ -41,8 +41,9 @@ fn assert_weights_normalised(animated: &Animated, file: &str) {
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn rigged_simple_has_one_clip_at_its_keyframes() {
-    let Some(path) = animated_file("RiggedSimple.glb") else { return };
+    let path = animated_file("RiggedSimple.glb");
     let animated = read_animated(&path, &all_clips()).unwrap();
     assert_eq!(animated.clips.len(), 1);
     assert_eq!(animated.mesh.vertex_count(), 96);
@@ -61,8 +62,9 @@ fn rigged_simple_has_one_clip_at_its_keyframes() {
 /// one bends. Posed at its middle keyframe, the bottom ring is where it was at rest and the top
 /// ring has moved.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn rigged_simple_bends_at_the_top_and_keeps_its_bottom() {
-    let Some(path) = animated_file("RiggedSimple.glb") else { return };
+    let path = animated_file("RiggedSimple.glb");
     let (animated, rest) = read_with_rest_pose(&path, &all_clips()).unwrap();
     let at_rest = animated.positions(&rest);
     let axis = {
@@ -88,8 +90,9 @@ fn rigged_simple_bends_at_the_top_and_keeps_its_bottom() {
 /// The rest mesh is the static loader's mesh before posing: the same vertices and triangles in
 /// the same order, and posed at rest the same positions.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn rest_pose_is_the_static_loaders_mesh() {
-    let Some(dir) = common::data_dir() else { return };
+    let dir = common::data_dir();
     for file in
         ["RiggedSimple.glb", "RiggedFigure.glb", "CesiumMan.glb", "Fox.glb", "Soldier.glb", "RobotExpressive.glb"]
     {
@@ -109,8 +112,9 @@ fn rest_pose_is_the_static_loaders_mesh() {
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn soldier_clips_pose_finite_positions() {
-    let Some(path) = animated_file("Soldier.glb") else { return };
+    let path = animated_file("Soldier.glb");
     let (animated, rest) = read_with_rest_pose(&path, &all_clips()).unwrap();
     let names: Vec<&str> = animated.clips.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["Idle", "Run", "TPose", "Walk"]);
@@ -135,8 +139,9 @@ fn soldier_clips_pose_finite_positions() {
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn resampling_gives_evenly_spaced_frames() {
-    let Some(path) = animated_file("Soldier.glb") else { return };
+    let path = animated_file("Soldier.glb");
     for n in [1, 2, 7, 30] {
         let animated = read_animated(&path, &ClipSelection { clip: Some("Walk".into()), frames: Some(n) }).unwrap();
         assert_eq!(animated.clips.len(), 1);
@@ -156,8 +161,9 @@ fn resampling_gives_evenly_spaced_frames() {
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn clips_are_chosen_by_name() {
-    let Some(path) = animated_file("Soldier.glb") else { return };
+    let path = animated_file("Soldier.glb");
     let run = read_animated(&path, &ClipSelection { clip: Some("Run".into()), frames: None }).unwrap();
     assert_eq!(run.clips.len(), 1);
     assert_eq!(run.clips[0].name, "Run");
@@ -174,8 +180,9 @@ fn clips_are_chosen_by_name() {
 type Clips = &'static [(&'static str, usize)];
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn khronos_and_mixamo_samples_load() {
-    let Some(dir) = common::data_dir() else { return };
+    let dir = common::data_dir();
     // (file, triangles, clips with their keyframe counts as MANIFEST.md lists them).
     let expected: [(&str, usize, Clips); 5] = [
         ("CesiumMan.glb", 4_672, &[("animation_0", 49)]),
@@ -204,8 +211,9 @@ fn khronos_and_mixamo_samples_load() {
 /// targets: its vertices follow the bone through the joint that stands for its node, and the
 /// clips carry its morph weights.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn robot_expressive_moves_its_rigid_head_and_animates_its_morphs() {
-    let Some(path) = animated_file("RobotExpressive.glb") else { return };
+    let path = animated_file("RobotExpressive.glb");
     let (animated, rest) = read_with_rest_pose(&path, &all_clips()).unwrap();
     assert_eq!(animated.morph_targets.len(), 3);
     assert_eq!(animated.clips.len(), 14);
@@ -228,8 +236,9 @@ fn robot_expressive_moves_its_rigid_head_and_animates_its_morphs() {
 
 /// The measurements the report quotes: size, joints, clips and frames, load time.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn shared_characters_match_the_manifest() {
-    let Some(dir) = common::data_dir() else { return };
+    let dir = common::data_dir();
     // (file, triangles, clips with their keyframe counts), as data/MANIFEST.md lists them.
     type Facts = (&'static str, usize, &'static [(&'static str, usize)]);
     let expected: [Facts; 3] = [
@@ -498,9 +507,10 @@ fn broken_skins_and_animations_are_errors_that_say_what_is_wrong() {
 /// posed original's bounding box (Loop's stencils and the blended influences are convex
 /// combinations, up to the blend of different joints' matrices: 2% of the box allowed).
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn soldier_subdivided_twice_still_walks() {
     use triorder::mesh::subdivide::loop_subdivide;
-    let Some(path) = animated_file("Soldier.glb") else { return };
+    let path = animated_file("Soldier.glb");
     let walk = ClipSelection { clip: Some("Walk".into()), frames: None };
     let animated = read_animated(&path, &walk).unwrap();
     let fine = loop_subdivide(&animated, 2).unwrap();

@@ -16,54 +16,40 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::PathBuf;
 
 use glam::{Mat4, Quat, Vec3};
-use triorder::eval::{MeasureOptions, measure_nodes};
-use triorder::mesh::Mesh;
-use triorder::mesh::gltf_animation::{ClipSelection, read_animated, read_with_rest_pose};
-use triorder::mesh::keyframes::Keyframes;
-use triorder::order::per_node::Lookup;
-use triorder::order::{self, NodeOrders, OrderInput, check_permutation};
+use triorder::measure::{MeasureOptions, measure};
+use triorder::mesh::gltf::animation::{ClipSelection, read_animated, read_with_rest_pose};
+use triorder::mesh::{Frames, Framing, Mesh, Scene};
+use triorder::order::{self, Lookup, Orders, check_permutation};
+use triorder::raster::ViewSet;
 use triorder::raster::cpu::CpuRaster;
 use triorder::raster::views::{icosphere_directions, perspective};
-use triorder::raster::{Framing, ViewSet};
-use triorder::topology::Topology;
 
-/// A mesh, its topology and its framed keyframes.
-struct Scene {
-    mesh: Mesh,
-    topology: Topology,
-    keyframes: Keyframes,
-}
-
-fn animated_path(file: &str) -> Option<PathBuf> {
-    Some(common::data_dir()?.join("animated").join(file))
+fn animated_path(file: &str) -> PathBuf {
+    common::animated_file(file)
 }
 
 /// `file`'s clip (`None`: every clip), each resampled to `frames` frames.
-fn animation(file: &str, clip: Option<&str>, frames: usize) -> Option<Scene> {
-    let path = animated_path(file)?;
+fn animation(file: &str, clip: Option<&str>, frames: usize) -> Scene {
+    let path = animated_path(file);
     let selection = ClipSelection { clip: clip.map(str::to_string), frames: Some(frames) };
     let animated = read_animated(&path, &selection).unwrap_or_else(|e| panic!("{e}"));
-    let keyframes = Keyframes::of(&animated);
-    let topology = Topology::new(&animated.mesh);
-    Some(Scene { mesh: animated.mesh, topology, keyframes })
+    let frames = Frames::of(&animated);
+    Scene::animated(animated.mesh, frames)
 }
 
 /// A static mesh as an animation of one frame.
 fn still(mesh: Mesh) -> Scene {
-    let keyframes = Keyframes::still(&mesh);
-    let topology = Topology::new(&mesh);
-    Scene { mesh, topology, keyframes }
+    Scene::still(mesh)
 }
 
 fn procedural(spec: &str) -> Mesh {
     triorder::mesh::procedural::generate(spec, 0).unwrap().unwrap()
 }
 
-/// The method's own output, not passed through `order::run_nodes`'s checks.
-fn order_nodes(spec: &str, scene: &Scene) -> NodeOrders {
+/// The method's own output, not passed through `order::run`'s checks.
+fn order_nodes(spec: &str, scene: &Scene) -> Orders {
     let resolved = order::resolve(spec, 0).unwrap_or_else(|e| panic!("{spec}: {e}"));
-    let input = OrderInput { mesh: &scene.mesh, topology: &scene.topology };
-    resolved.ordering.order_nodes(&input, &scene.keyframes).unwrap_or_else(|e| panic!("{spec}: {e}"))
+    resolved.ordering.order(scene).unwrap_or_else(|e| panic!("{spec}: {e}"))
 }
 
 /// The buffer ids the lookup cells of `frames` name.
@@ -74,36 +60,36 @@ fn buffers_used(lookup: &Lookup, frames: std::ops::Range<usize>) -> BTreeSet<u16
 
 /// Every buffer a permutation of the triangles; a lookup of exactly one table per keyframe whose
 /// every cell names an existing buffer; and no buffer that no cell can pick.
-fn assert_well_formed(spec: &str, scene: &Scene, nodes: &NodeOrders) {
+fn assert_well_formed(spec: &str, scene: &Scene, nodes: &Orders) {
     assert!(!nodes.buffers.is_empty(), "{spec}: no buffer");
     for (i, buffer) in nodes.buffers.iter().enumerate() {
-        check_permutation(buffer, scene.mesh.triangle_count())
+        check_permutation(&buffer.order, scene.mesh.triangle_count())
             .unwrap_or_else(|why| panic!("{spec}: buffer {i}: {why}"));
     }
-    assert_eq!(nodes.lookup.frames(), scene.keyframes.len(), "{spec}");
-    assert_eq!(nodes.lookup.cells().len(), scene.keyframes.len() * nodes.lookup.cells_per_frame(), "{spec}");
-    let used = buffers_used(&nodes.lookup, 0..scene.keyframes.len());
+    assert_eq!(nodes.lookup.frames(), scene.frames.len(), "{spec}");
+    assert_eq!(nodes.lookup.cells().len(), scene.frames.len() * nodes.lookup.cells_per_frame(), "{spec}");
+    let used = buffers_used(&nodes.lookup, 0..scene.frames.len());
     assert!(used.iter().all(|&b| usize::from(b) < nodes.buffers.len()), "{spec}: {used:?}");
     assert_eq!(used.len(), nodes.buffers.len(), "{spec}: buffers no lookup cell picks");
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn every_buffer_is_a_permutation_and_every_cell_names_one() {
     for (file, frames) in [("RiggedSimple.glb", 3), ("RiggedFigure.glb", 3), ("Fox.glb", 2)] {
-        let Some(scene) = animation(file, None, frames) else { return };
+        let scene = animation(file, None, frames);
         for spec in ["hs17:views=12,res=32", "hs17:views=12,res=32,mode=joint,clusters=3", "tipsify-per-frame"] {
             let nodes = order_nodes(spec, &scene);
             assert_well_formed(&format!("{file} {spec}"), &scene, &nodes);
             // The checked entry point accepts what the method returned, unchanged.
             let resolved = order::resolve(spec, 0).unwrap();
-            let input = OrderInput { mesh: &scene.mesh, topology: &scene.topology };
-            let checked = order::run_nodes(&resolved, &input, &scene.keyframes).unwrap();
+            let checked = order::run(&resolved, &scene).unwrap();
             assert_eq!((checked.buffers, checked.lookup), (nodes.buffers, nodes.lookup), "{file} {spec}");
         }
         // One buffer per keyframe, drawn from every direction of that keyframe only.
         let per_frame = order_nodes("tipsify-per-frame", &scene);
-        assert_eq!(per_frame.buffers.len(), scene.keyframes.len(), "{file}");
-        for f in 0..scene.keyframes.len() {
+        assert_eq!(per_frame.buffers.len(), scene.frames.len(), "{file}");
+        for f in 0..scene.frames.len() {
             assert_eq!(buffers_used(&per_frame.lookup, f..f + 1), BTreeSet::from([f as u16]), "{file} frame {f}");
         }
     }
@@ -112,9 +98,10 @@ fn every_buffer_is_a_permutation_and_every_cell_names_one() {
 /// `mode=single` runs k-means per clip: a frame of one clip never draws with a buffer made for
 /// another, and each clip has at most k. `mode=joint` shares at most k buffers among all clips.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn single_mode_keeps_clips_apart_and_joint_mode_shares_k_buffers() {
-    let Some(scene) = animation("Fox.glb", None, 2) else { return };
-    let clips = &scene.keyframes.clips;
+    let scene = animation("Fox.glb", None, 2);
+    let clips = &scene.frames.clips;
     assert!(clips.len() >= 2, "Fox has several clips: {clips:?}");
     let k = 3;
     let single = order_nodes(&format!("hs17:views=12,res=32,clusters={k}"), &scene);
@@ -133,8 +120,9 @@ fn single_mode_keeps_clips_apart_and_joint_mode_shares_k_buffers() {
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn same_seed_same_buffers_and_lookup() {
-    let Some(scene) = animation("Fox.glb", Some("Walk"), 3) else { return };
+    let scene = animation("Fox.glb", Some("Walk"), 3);
     for spec in ["hs17:views=12,res=32,seed=7", "hs17:views=42,res=32,seed=7,mode=joint", "tipsify-per-frame"] {
         let (a, b) = (order_nodes(spec, &scene), order_nodes(spec, &scene));
         assert!(a.buffers == b.buffers, "{spec}: buffers differ between runs");
@@ -144,8 +132,7 @@ fn same_seed_same_buffers_and_lookup() {
     // The run seed stands in for a missing `seed=`: resolving with the same run seed agrees with
     // writing it out.
     let resolved = order::resolve("hs17:views=12,res=32", 7).unwrap();
-    let input = OrderInput { mesh: &scene.mesh, topology: &scene.topology };
-    let implicit = resolved.ordering.order_nodes(&input, &scene.keyframes).unwrap();
+    let implicit = resolved.ordering.order(&scene).unwrap();
     let explicit = order_nodes("hs17:views=12,res=32,seed=7", &scene);
     assert!(implicit.buffers == explicit.buffers && implicit.lookup == explicit.lookup);
 }
@@ -155,8 +142,9 @@ fn same_seed_same_buffers_and_lookup() {
 /// convergence (there is no previous assignment to compare with), so `iterations=1` is always
 /// unconverged; one cluster converges in the round after the first.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn kmeans_reports_its_rounds_and_whether_it_converged() {
-    let Some(scene) = animation("RiggedFigure.glb", None, 3) else { return };
+    let scene = animation("RiggedFigure.glb", None, 3);
     let base = "hs17:views=42,res=32,clusters=5,seed=1";
     let free = order_nodes(base, &scene);
     let Some(n) = free.iterations else { panic!("hs17 reports its rounds") };
@@ -184,23 +172,25 @@ fn kmeans_reports_its_rounds_and_whether_it_converged() {
 }
 
 /// Mean OVR of `nodes` drawn from `views` random cameras, each with the buffer its lookup picks.
-fn mean_ovr(scene: &Scene, nodes: &NodeOrders, views: u32, seed: u64) -> f64 {
+fn mean_ovr(scene: &Scene, nodes: &Orders, views: u32, seed: u64) -> f64 {
     let options =
         MeasureOptions { caches: vec![], views: Some(ViewSet::Random(views)), res: 64, seed, ..Default::default() };
-    let measured = measure_nodes(&scene.mesh, &scene.keyframes, nodes, &options, &CpuRaster).unwrap();
-    measured.overdraw[0].overdraw.summary.expect("the views see the mesh").mean
+    let measured = measure(scene, nodes, &options, &CpuRaster).unwrap();
+    let values = measured.iter().flat_map(|m| &m.values);
+    values.filter(|v| v.metric == "ovr_mean" && v.is_summary()).map(|v| v.value).next().expect("the views see the mesh")
 }
 
 /// A static mesh is an animation of one frame; hs17 then clusters viewpoints only. On meshes
 /// that occlude themselves, k view-dependent buffers draw with no more overdraw than one, and a
 /// single cluster gives one buffer used everywhere.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn static_mesh_gets_view_clustered_buffers() {
     let mut meshes = vec![("helix:3".to_string(), procedural("helix:3"))];
-    meshes.extend(common::real_mesh("bunny_2k.ply").map(|m| ("bunny_2k".to_string(), m)));
+    meshes.push(("bunny_2k".to_string(), common::real_mesh("bunny_2k.ply")));
     for (name, mesh) in meshes {
         let scene = still(mesh);
-        assert_eq!(scene.keyframes.len(), 1);
+        assert_eq!(scene.frames.len(), 1);
         let one = order_nodes("hs17:views=42,res=64,clusters=1", &scene);
         assert_eq!(one.buffers.len(), 1, "{name}");
         assert!(one.lookup.cells().iter().all(|&b| b == 0), "{name}");
@@ -218,22 +208,22 @@ fn static_mesh_gets_view_clustered_buffers() {
 /// `tipsify-per-frame` reorders the same patches per frame by the dot rule: buffer f is exactly
 /// `sander07` with the same parameters on the mesh posed (and framed) at keyframe f.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn tipsify_per_frame_is_sander07_on_each_posed_frame() {
     for (file, frames) in [("RiggedFigure.glb", 3), ("Fox.glb", 2)] {
-        let Some(scene) = animation(file, None, frames) else { return };
+        let scene = animation(file, None, frames);
         for params in ["", ":cache=12,lambda=0.6"] {
             let nodes = order_nodes(&format!("tipsify-per-frame{params}"), &scene);
             let sander07 = order::resolve(&format!("sander07{params}"), 0).unwrap();
-            assert_eq!(nodes.buffers.len(), scene.keyframes.len());
+            assert_eq!(nodes.buffers.len(), scene.frames.len());
             let mut distinct = BTreeSet::new();
-            for f in 0..scene.keyframes.len() {
-                let posed = scene.keyframes.posed(&scene.mesh, f);
-                let topology = Topology::new(&posed);
-                let expected = order::run(&sander07, &OrderInput { mesh: &posed, topology: &topology }).unwrap();
-                assert!(nodes.buffers[f] == expected, "{file}{params}: frame {f} differs from sander07");
+            for f in 0..scene.frames.len() {
+                let posed = scene.frames.posed(&scene.mesh, f);
+                let expected = common::static_order(&sander07, &posed).unwrap();
+                assert!(nodes.buffers[f].order == expected, "{file}{params}: frame {f} differs from sander07");
                 distinct.insert(expected);
             }
-            eprintln!("{file}{params}: {} distinct buffers over {} frames", distinct.len(), scene.keyframes.len());
+            eprintln!("{file}{params}: {} distinct buffers over {} frames", distinct.len(), scene.frames.len());
         }
     }
 }
@@ -314,8 +304,9 @@ impl HandPose {
 /// at rest every skinning matrix is the mesh node's placement, so the rest pose is the bind-pose
 /// mesh, rigidly placed.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn rigged_simple_skins_one_vertex_as_computed_by_hand() {
-    let Some(path) = animated_path("RiggedSimple.glb") else { return };
+    let path = animated_path("RiggedSimple.glb");
     let (document, buffers, _) = gltf::import(&path).unwrap();
     let data = |b: gltf::Buffer| Some(&buffers[b.index()][..]);
 

@@ -4,19 +4,18 @@
 
 mod common;
 
-use triorder::metrics::cache::{CacheModel, simulate};
-use triorder::order::{self, OrderInput};
-use triorder::topology::Topology;
+use triorder::measure::cache::{CacheModel, simulate};
+use triorder::order;
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn fifo_and_batch_equal_meshopt_on_real_meshes() {
     let mut checked = 0;
     for name in ["bunny_2k.ply", "dragon_vrip_res3.ply", "happy_buddha_100k.obj", "pirate.obj"] {
-        let Some(mesh) = common::real_mesh(name) else { return };
-        let topology = Topology::new(&mesh);
+        let mesh = common::real_mesh(name);
         for method in ["input", "random:seed=3", "meshopt-vcache"] {
             let resolved = order::resolve(method, 0).unwrap();
-            let ordered = order::run(&resolved, &OrderInput { mesh: &mesh, topology: &topology }).unwrap();
+            let ordered = common::static_order(&resolved, &mesh).unwrap();
             let triangles = mesh.triangles_in_order(&ordered);
             let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
             let n = mesh.vertex_count();

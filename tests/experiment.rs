@@ -6,14 +6,13 @@ mod common;
 use std::collections::HashMap;
 use std::path::Path;
 
-use triorder::eval::{MeasureOptions, evaluate};
-use triorder::experiment::row::COLUMNS;
-use triorder::experiment::{RunOptions, Spec, reproduce, run};
-use triorder::figure::{PlotOptions, plot};
-use triorder::mesh::source;
-use triorder::metrics::CacheModel;
-use triorder::topology::Topology;
-use triorder::{order, raster};
+use triorder::experiment::{RunOptions, Spec, run};
+use triorder::figure::PlotOptions;
+use triorder::measure::{CacheModel, MeasureOptions, evaluate};
+use triorder::mesh::Source;
+use triorder::reproduce::{plot, reproduce};
+use triorder::results::COLUMNS;
+use triorder::{measure, order};
 
 /// A spec small enough to run in milliseconds: two procedural models (the grid is flat, so some
 /// of its views see nothing), three methods (a seed grid), three cache models and six views.
@@ -192,38 +191,38 @@ fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
         seed: spec.seed,
         ..Default::default()
     };
-    let cpu = raster::backend("cpu").unwrap();
+    let cpu = measure::backend("cpu").unwrap();
     let mut expected_rows = 0;
     for model in &work.models {
-        let mesh = source::open(model, None, spec.seed).unwrap();
-        let topology = Topology::new(&mesh);
+        let (name, scene) = (&model.name, model.source.open(None, spec.seed).unwrap());
         for method in &spec.methods {
-            let direct =
-                evaluate(&mesh, &topology, &order::resolve(method, spec.seed).unwrap(), &options, cpu.as_ref())
-                    .unwrap();
-            let mine: Vec<_> = rows.iter().filter(|r| r["model"] == *model && r["method"] == *method).collect();
+            let direct = evaluate(&scene, &order::resolve(method, spec.seed).unwrap(), &options, cpu.as_ref()).unwrap();
+            let mine: Vec<_> = rows.iter().filter(|r| r["model"] == *name && r["method"] == *method).collect();
             let value = |metric: &str, cache: &str, view: &str| -> f64 {
                 let hits: Vec<_> =
                     mine.iter().filter(|r| r["metric"] == metric && r["cache"] == cache && r["view"] == view).collect();
-                assert_eq!(hits.len(), 1, "{model} {method} {metric} {cache} {view}");
+                assert_eq!(hits.len(), 1, "{name} {method} {metric} {cache} {view}");
                 hits[0]["value"].parse().unwrap()
             };
-            for (cache, stats) in &direct.measurement.caches {
+            for cache in &work.caches {
+                let stats = triorder::measure::cache::simulate(
+                    *cache,
+                    &scene.mesh.triangles_in_order(&direct.orders.buffers[0].order),
+                    scene.mesh.vertex_count(),
+                );
                 assert_eq!(value("acmr", &cache.to_string(), ""), stats.acmr());
                 assert_eq!(value("atvr", &cache.to_string(), ""), stats.atvr());
             }
-            let overdraw = direct.measurement.overdraw.as_ref().unwrap();
-            let visible: Vec<_> =
-                overdraw.per_view.iter().enumerate().filter_map(|(i, v)| Some((i, v.ovr()?))).collect();
+            let visible = direct.values().filter(|v| v.metric == "ovr").count();
+            assert!(visible > 0);
             // The figure draws ACMR, so the per-view ratios are summarised, not written.
             assert!(mine.iter().all(|r| r["metric"] != "ovr"));
-            assert_eq!(value("ovr_empty", "", "") as usize, 6 - visible.len());
-            let summary = overdraw.summary.unwrap();
-            assert_eq!(value("ovr_mean", "", ""), summary.mean);
-            assert_eq!(value("ovr_max", "", ""), summary.max);
-            assert_eq!(value("ovr_var", "", ""), summary.variance);
+            assert_eq!(value("ovr_empty", "", "") as usize, 6 - visible);
+            for metric in ["ovr_mean", "ovr_max", "ovr_var"] {
+                assert_eq!(value(metric, "", ""), direct.summary(metric).unwrap());
+            }
             let r = mine[0];
-            assert_eq!(r["model_triangles"], mesh.triangle_count().to_string());
+            assert_eq!(r["model_triangles"], scene.mesh.triangle_count().to_string());
             assert_eq!((r["method_name"].as_str(), r["seed"].as_str()), (method.split(':').next().unwrap(), "3"));
             assert_eq!((r["backend"].as_str(), r["triorder"].as_str()), ("cpu", env!("CARGO_PKG_VERSION")));
             assert!(!r["machine"].is_empty() && !r["commit"].is_empty());
@@ -270,28 +269,19 @@ fn per_view_rows_are_written_when_the_figure_draws_them() {
     let options =
         MeasureOptions { caches: vec![], views: work.views, res: work.res, seed: spec.seed, ..Default::default() };
     for model in &work.models {
-        let mesh = source::open(model, None, spec.seed).unwrap();
-        let topology = Topology::new(&mesh);
+        let (name, scene) = (&model.name, model.source.open(None, spec.seed).unwrap());
         for method in &spec.methods {
             let resolved = order::resolve(method, spec.seed).unwrap();
-            let direct = evaluate(&mesh, &topology, &resolved, &options, raster::backend("cpu").unwrap().as_ref());
-            let expected: Vec<(String, f64)> = direct
-                .unwrap()
-                .measurement
-                .overdraw
-                .unwrap()
-                .per_view
-                .iter()
-                .enumerate()
-                .filter_map(|(i, v)| Some((i.to_string(), v.ovr()?)))
-                .collect();
+            let direct = evaluate(&scene, &resolved, &options, measure::backend("cpu").unwrap().as_ref()).unwrap();
+            let expected: Vec<(String, f64)> =
+                direct.values().filter(|v| v.metric == "ovr").map(|v| (v.view.unwrap().to_string(), v.value)).collect();
             let written: Vec<(String, f64)> = rows
                 .iter()
-                .filter(|r| r["model"] == *model && r["method"] == *method && r["metric"] == "ovr")
+                .filter(|r| r["model"] == *name && r["method"] == *method && r["metric"] == "ovr")
                 .map(|r| (r["view"].clone(), r["value"].parse().unwrap()))
                 .collect();
             assert!(!written.is_empty());
-            assert_eq!(written, expected, "{model} {method}");
+            assert_eq!(written, expected, "{name} {method}");
         }
     }
 }
@@ -403,11 +393,12 @@ fn reproduce_runs_and_plots_every_matching_spec_in_order() {
     let root = tempfile::tempdir().unwrap();
     common::write_spec(root.path(), "tiny", TINY);
     common::write_spec(root.path(), "another", &TINY.replace("id = \"tiny\"", "id = \"another\""));
-    let outputs = reproduce(&quick(root.path()), None).unwrap();
-    let ids: Vec<_> = outputs.iter().map(|(csv, _)| csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
+    let outputs = reproduce(&quick(root.path()), None).unwrap().ran;
+    let ids: Vec<_> =
+        outputs.iter().map(|(_, csv, _)| csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
     assert_eq!(ids, ["another", "tiny"]);
-    assert!(outputs.iter().all(|(csv, svg)| csv.is_file() && svg.is_file()));
-    assert_eq!(reproduce(&quick(root.path()), Some("tin")).unwrap().len(), 1);
+    assert!(outputs.iter().all(|(_, csv, svg)| csv.is_file() && svg.is_file()));
+    assert_eq!(reproduce(&quick(root.path()), Some("tin")).unwrap().ran.len(), 1);
     let err = reproduce(&quick(root.path()), Some("nothing")).unwrap_err().to_string();
     assert!(err.contains("matching `nothing`"), "{err}");
     // A broken spec stops everything before any run.
@@ -432,7 +423,7 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     run(&path, &quick(root.path())).unwrap();
     let orders = root.path().join("results/quick/corners.orders.csv");
     let (header, rows) = read_csv(&orders);
-    assert_eq!(header, ["model", "method", "order", "clusters"]);
+    assert_eq!(header, ["model", "method", "order", "clusters", "corners", "overdraw"]);
     // One whole order per (model, method): 80 and 32 triangles, three methods, none clustered.
     assert_eq!(rows.len(), 2 * 3);
     let lengths: Vec<usize> = rows.iter().map(|r| r["order"].split(' ').count()).collect();
@@ -443,14 +434,15 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     // Two models × three methods × three caches, one picture each.
     assert_eq!(svg.matches("<image").count(), 18);
 
-    // Swap two triangles of one saved order: its corner counts no longer match the CSV's ACMR.
+    // Swap two triangles of one saved order: the saved corners no longer fit it.
     let text = std::fs::read_to_string(&orders).unwrap();
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
     let input = lines.iter().position(|l| l.starts_with("sphere:80,input,")).unwrap();
-    let fields: Vec<&str> = lines[input].split(',').collect();
+    let mut fields: Vec<String> = lines[input].split(',').map(String::from).collect();
     let mut ids: Vec<&str> = fields[2].split(' ').collect();
     ids.swap(0, 40);
-    lines[input] = format!("{},{},{},{}", fields[0], fields[1], ids.join(" "), fields[3]);
+    fields[2] = ids.join(" ");
+    lines[input] = fields.join(",");
     std::fs::write(&orders, lines.join("\n") + "\n").unwrap();
     let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
     assert!(err.contains("corners.orders.csv") && err.contains("rerun the experiment"), "{err}");
@@ -458,19 +450,20 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
 
 #[test]
 fn simplified_models_are_named_with_their_triangle_count() {
-    let mesh = source::open("assets/spot.obj@1000", None, 0).unwrap();
+    let open = |source: &str| Source::parse(source)?.mesh(None, 0);
+    let mesh = open("assets/spot.obj@1000").unwrap();
     assert!((980..=1020).contains(&mesh.triangle_count()), "{}", mesh.triangle_count());
     assert!(mesh.triangles.iter().flatten().all(|&v| (v as usize) < mesh.vertex_count()));
     // No unused vertices are kept.
     let mut used = vec![false; mesh.vertex_count()];
     mesh.triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
     assert!(used.iter().all(|&u| u));
-    let simplified_grid = source::open("grid:20x20@200", None, 0).unwrap();
+    let simplified_grid = open("grid:20x20@200").unwrap();
     assert!((196..=204).contains(&simplified_grid.triangle_count()), "{}", simplified_grid.triangle_count());
     for (bad, want) in [("assets/spot.obj@0", "positive"), ("assets/spot.obj@9999999", "only 5856")] {
-        let err = source::open(bad, None, 0).unwrap_err().to_string();
+        let err = open(bad).unwrap_err().to_string();
         assert!(err.contains(bad) && err.contains(want), "{err}");
-        assert!(source::check(bad, None).is_err() || want == "only 5856");
+        assert!(Source::parse(bad).and_then(|s| s.check(None)).is_err() || want == "only 5856");
     }
 }
 

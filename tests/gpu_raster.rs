@@ -12,11 +12,11 @@
 
 mod common;
 
+use triorder::mesh::Framing;
 use triorder::mesh::{Mesh, load};
-use triorder::order::{self, OrderInput};
+use triorder::order;
 use triorder::raster::cpu::CpuRaster;
-use triorder::raster::{Framing, RasterBackend, ViewSet};
-use triorder::topology::Topology;
+use triorder::raster::{RasterBackend, ViewSet};
 
 /// Sums of |gpu − cpu| over views, per count, and the CPU's total fragments (those that pass the
 /// depth test: the fragments a renderer shades).
@@ -30,9 +30,8 @@ struct Difference {
 /// Compares the backends on every view; with `per_view`, each view must be within 0.1% (or one
 /// fragment in 1,000 when it has fewer than 1,000).
 fn compare(name: &str, mesh: &Mesh, method: &str, views: &str, res: u32, per_view: bool) -> Difference {
-    let gpu = common::gpu().expect("checked by the caller");
-    let topology = Topology::new(mesh);
-    let order = order::resolve(method, 1).unwrap().ordering.order(&OrderInput { mesh, topology: &topology }).unwrap();
+    let gpu = common::gpu();
+    let order = common::static_order(&order::resolve(method, 1).unwrap(), mesh).unwrap();
     let triangles = mesh.triangles_in_order(&order);
     let cameras = views.parse::<ViewSet>().unwrap().cameras(Framing::of(&mesh.positions), 5);
     let cpu = CpuRaster.count(&mesh.positions, &triangles, &cameras, res).unwrap();
@@ -63,15 +62,12 @@ fn compare(name: &str, mesh: &Mesh, method: &str, views: &str, res: u32, per_vie
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
+#[cfg_attr(not(triorder_gpu), ignore = "needs a Vulkan driver (sudo apt-get install mesa-vulkan-drivers libvulkan1)")]
 fn real_meshes_count_within_a_tenth_of_a_percent() {
-    if common::gpu().is_none() {
-        return;
-    }
     let mut meshes = vec![("spot".to_string(), load::load_file(std::path::Path::new("assets/spot.obj")).unwrap())];
     for name in ["bun_zipper.ply", "horse.ply"] {
-        if let Some(mesh) = common::real_mesh(name) {
-            meshes.push((name.to_string(), mesh));
-        }
+        meshes.push((name.to_string(), common::real_mesh(name)));
     }
     for (name, mesh) in &meshes {
         for method in ["input", "random"] {
@@ -91,11 +87,10 @@ fn real_meshes_count_within_a_tenth_of_a_percent() {
 /// snapped vertices, lavapipe its own way. At 512² a single view of the 11k dragon differs by up
 /// to 0.2% of its fragments (other meshes: under 0.01%); over ico:162 the total stays under 0.1%.
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
+#[cfg_attr(not(triorder_gpu), ignore = "needs a Vulkan driver (sudo apt-get install mesa-vulkan-drivers libvulkan1)")]
 fn overlapping_surfaces_count_within_a_tenth_of_a_percent_over_the_view_set() {
-    if common::gpu().is_none() {
-        return;
-    }
-    let Some(mesh) = common::real_mesh("dragon_vrip_res4.ply") else { return };
+    let mesh = common::real_mesh("dragon_vrip_res4.ply");
     for method in ["input", "random"] {
         let d = compare("dragon_vrip_res4", &mesh, method, "ico:162", 512, false);
         for delta in [d.covered, d.passed] {
@@ -117,8 +112,9 @@ fn eval_json(backend: &str) -> serde_json::Value {
 }
 
 #[test]
+#[cfg_attr(not(triorder_gpu), ignore = "needs a Vulkan driver (sudo apt-get install mesa-vulkan-drivers libvulkan1)")]
 fn eval_names_the_device_and_matches_the_cpu() {
-    let Some(gpu) = common::gpu() else { return };
+    let gpu = common::gpu();
     let (cpu, on_gpu) = (eval_json("cpu"), eval_json("gpu"));
     assert_eq!(cpu["backend"], "cpu");
     assert_eq!(on_gpu["backend"], format!("gpu: {}", gpu.device()));
@@ -129,8 +125,9 @@ fn eval_names_the_device_and_matches_the_cpu() {
 }
 
 #[test]
+#[cfg_attr(not(triorder_gpu), ignore = "needs a Vulkan driver (sudo apt-get install mesa-vulkan-drivers libvulkan1)")]
 fn a_spec_runs_on_the_gpu_and_its_rows_name_the_device() {
-    let Some(gpu) = common::gpu() else { return };
+    let gpu = common::gpu();
     let root = tempfile::tempdir().unwrap();
     let spec = common::write_spec(
         root.path(),
@@ -173,11 +170,12 @@ x = "method"
 /// The backend benchmark times only work that succeeds: a resolution both backends refuse is an
 /// error, not a row of timed failures.
 #[test]
+#[cfg_attr(not(triorder_gpu), ignore = "needs a Vulkan driver (sudo apt-get install mesa-vulkan-drivers libvulkan1)")]
 fn the_backend_benchmark_refuses_what_it_cannot_count() {
-    let Some(gpu) = common::gpu() else { return };
+    let gpu = common::gpu();
     let spot = load::load_file(std::path::Path::new("assets/spot.obj")).unwrap();
-    let row = triorder::bench::compare_backends(&spot, gpu, ViewSet::Ico(12), 64, 1).unwrap();
+    let row = triorder::experiment::bench::compare_backends(&spot, gpu, ViewSet::Ico(12), 64, 1).unwrap();
     assert!(row.cpu_seconds > 0.0 && row.gpu_seconds > 0.0, "{row:?}");
-    let refused = triorder::bench::compare_backends(&spot, gpu, ViewSet::Ico(12), 20_000, 1);
+    let refused = triorder::experiment::bench::compare_backends(&spot, gpu, ViewSet::Ico(12), 20_000, 1);
     assert!(refused.unwrap_err().to_string().contains("resolution"));
 }

@@ -4,14 +4,14 @@
 
 mod common;
 
+use triorder::measure::cache::{CacheModel, simulate};
+use triorder::mesh::topology::Topology;
 use triorder::mesh::{Mesh, VertexAttributes, procedural};
-use triorder::metrics::cache::{CacheModel, simulate};
-use triorder::order::{self, OrderInput};
-use triorder::topology::Topology;
+use triorder::order;
 
-fn ordered(mesh: &Mesh, topology: &Topology, spec: &str) -> Vec<[u32; 3]> {
+fn ordered(mesh: &Mesh, spec: &str) -> Vec<[u32; 3]> {
     let resolved = order::resolve(spec, 0).unwrap();
-    let order = order::run(&resolved, &OrderInput { mesh, topology }).unwrap_or_else(|e| panic!("{spec}: {e}"));
+    let order = common::static_order(&resolved, mesh).unwrap_or_else(|e| panic!("{spec}: {e}"));
     mesh.triangles_in_order(&order)
 }
 
@@ -20,15 +20,16 @@ fn misses(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize) -> u64
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn never_worse_than_random_at_any_fifo_size() {
     let mut checked = 0;
     for name in common::STATIC_MODELS {
-        let Some(mesh) = common::real_mesh(name) else { return };
-        let topology = Topology::new(&mesh);
+        let mesh = common::real_mesh(name);
+        let _topology = Topology::new(&mesh);
         let n = mesh.vertex_count();
-        let random = ordered(&mesh, &topology, "random:seed=1");
+        let random = ordered(&mesh, "random:seed=1");
         for spec in ["hoppe:cache=16", "kcache:cache=16"] {
-            let ours = ordered(&mesh, &topology, spec);
+            let ours = ordered(&mesh, spec);
             for k in 3..=64 {
                 let model = CacheModel::Fifo(k);
                 let (a, b) = (misses(model, &ours, n), misses(model, &random, n));
@@ -49,14 +50,14 @@ fn hoppe_reaches_the_strip_steady_state_on_a_grid() {
     // cells do not split evenly into strips of 7, so allow up to 0.60 (Tipsify gets 0.64 here;
     // random orders on large grids approach 3).
     let mesh = procedural::generate("grid:32x32", 0).unwrap().unwrap();
-    let topology = Topology::new(&mesh);
-    let triangles = ordered(&mesh, &topology, "hoppe:cache=16");
+    let _topology = Topology::new(&mesh);
+    let triangles = ordered(&mesh, "hoppe:cache=16");
     let acmr = simulate(CacheModel::Fifo(16), &triangles, mesh.vertex_count()).acmr();
     assert!(acmr < 0.60, "hoppe:cache=16 on grid:32x32: ACMR {acmr} at fifo:16");
     // And on a larger grid the boundary matters less: closer to 8/14.
     let mesh = procedural::generate("grid:100x100", 0).unwrap().unwrap();
-    let topology = Topology::new(&mesh);
-    let triangles = ordered(&mesh, &topology, "hoppe:cache=16");
+    let _topology = Topology::new(&mesh);
+    let triangles = ordered(&mesh, "hoppe:cache=16");
     let acmr = simulate(CacheModel::Fifo(16), &triangles, mesh.vertex_count()).acmr();
     assert!(acmr < 0.58, "hoppe:cache=16 on grid:100x100: ACMR {acmr} at fifo:16");
 }
@@ -86,9 +87,9 @@ fn hoppe_draws_a_fan_around_its_centre() {
     // Best possible: the 8 triangles one after the other around the centre, each sharing an
     // edge with the previous one, every vertex loaded exactly once (9 misses, ACMR 9/8).
     let mesh = fan();
-    let topology = Topology::new(&mesh);
+    let _topology = Topology::new(&mesh);
     for spec in ["hoppe:cache=16", "hoppe:cache=4"] {
-        let triangles = ordered(&mesh, &topology, spec);
+        let triangles = ordered(&mesh, spec);
         for pair in triangles.windows(2) {
             assert!(share_an_edge(pair[0], pair[1]), "{spec}: {triangles:?}");
         }
@@ -109,8 +110,8 @@ fn kcache_on_a_fan_follows_its_cost_function() {
     // - last, 4 (409) beats 0 (two triangles, 411) and 6 (422); pushing 5 for (0,4,5) makes
     //   (0,5,6) fully cached, and a fully cached triangle is drawn at once, before (0,4,5).
     let mesh = fan();
-    let topology = Topology::new(&mesh);
-    let triangles = ordered(&mesh, &topology, "kcache:cache=16");
+    let _topology = Topology::new(&mesh);
+    let triangles = ordered(&mesh, "kcache:cache=16");
     let expected = [[0, 1, 2], [0, 8, 1], [0, 2, 3], [0, 7, 8], [0, 3, 4], [0, 6, 7], [0, 5, 6], [0, 4, 5]];
     assert_eq!(triangles, expected);
     assert_eq!(misses(CacheModel::Fifo(16), &triangles, mesh.vertex_count()), 9);
@@ -124,9 +125,9 @@ fn a_ribbon_is_drawn_as_one_strip() {
     let grid = procedural::generate("grid:12x1", 0).unwrap().unwrap();
     let reversed: Vec<[u32; 3]> = grid.triangles.iter().rev().copied().collect();
     let mesh = Mesh { triangles: reversed, ..grid };
-    let topology = Topology::new(&mesh);
+    let _topology = Topology::new(&mesh);
     for spec in ["hoppe:cache=16", "kcache:cache=16"] {
-        let triangles = ordered(&mesh, &topology, spec);
+        let triangles = ordered(&mesh, spec);
         for pair in triangles.windows(2) {
             assert!(share_an_edge(pair[0], pair[1]), "{spec}: {triangles:?}");
         }
@@ -143,10 +144,10 @@ fn copies_and_loose_triangles_are_handled() {
         vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [1., 1., 0.], [5., 5., 0.], [6., 5., 0.], [5., 6., 0.]],
         vec![[0, 1, 2], [4, 5, 6], [2, 1, 3], [0, 1, 2], [1, 1, 3]],
     );
-    let topology = Topology::new(&mesh);
+    let _topology = Topology::new(&mesh);
     for spec in ["hoppe:cache=3", "kcache:cache=3", "hoppe:cache=16", "kcache:cache=16"] {
         let resolved = order::resolve(spec, 0).unwrap();
-        let order = order::run(&resolved, &OrderInput { mesh: &mesh, topology: &topology }).unwrap();
+        let order = common::static_order(&resolved, &mesh).unwrap();
         // The copy is drawn next to its original, when its vertices are certainly cached.
         let at = |t: u32| order.iter().position(|&x| x == t).unwrap();
         assert_eq!(at(0).abs_diff(at(3)), 1, "{spec}: {order:?}");
@@ -185,12 +186,11 @@ fn pathological_inputs_give_permutations_quickly() {
         (0..3000u32).map(|i| [i % 300, (i * 7) % 300, (i * 13) % 300]).collect(),
     );
     for mesh in [big_fan, soup, one_point] {
-        let topology = Topology::new(&mesh);
+        let _topology = Topology::new(&mesh);
         for spec in ["hoppe:cache=3", "hoppe:cache=16", "hoppe:cache=128", "kcache:cache=3", "kcache:cache=128"] {
             let start = std::time::Instant::now();
             let resolved = order::resolve(spec, 0).unwrap();
-            order::run(&resolved, &OrderInput { mesh: &mesh, topology: &topology })
-                .unwrap_or_else(|e| panic!("{spec} on {}: {e}", mesh.name));
+            common::static_order(&resolved, &mesh).unwrap_or_else(|e| panic!("{spec} on {}: {e}", mesh.name));
             eprintln!("{spec} on {}: {:.3} s", mesh.name, start.elapsed().as_secs_f64());
         }
     }

@@ -8,9 +8,10 @@
 mod common;
 
 use glam::{Mat4, Vec3};
+use triorder::measure::OverdrawSummary;
+use triorder::mesh::Framing;
 use triorder::mesh::{Mesh, VertexAttributes, procedural};
-use triorder::metrics::OverdrawSummary;
-use triorder::raster::{Camera, Framing, ViewCounts, ViewSet};
+use triorder::raster::{Camera, ViewCounts, ViewSet};
 
 /// Identity camera: world = NDC (x, y in -1..1 map to the image, z in 0..1 is depth).
 fn ndc_camera() -> Camera {

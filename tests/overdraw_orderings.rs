@@ -5,10 +5,11 @@
 
 mod common;
 
+use triorder::mesh::Framing;
 use triorder::mesh::{Mesh, procedural};
-use triorder::order::feedback_arc_set::{backward_weight, greedy_order};
-use triorder::order::overdraw_graph::{ClusteredDraw, OverdrawGraph, one_pass, pair_by_pair};
-use triorder::raster::{Framing, ViewSet};
+use triorder::order::nehab::feedback_arc_set::{backward_weight, greedy_order};
+use triorder::order::nehab::overdraw_graph::{ClusteredDraw, OverdrawGraph, one_pass, pair_by_pair};
+use triorder::raster::ViewSet;
 
 fn generate(spec: &str) -> Mesh {
     procedural::generate(spec, 1).unwrap().unwrap()
@@ -59,8 +60,9 @@ fn one_pass_equals_pair_by_pair_on_the_helix() {
 }
 
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn one_pass_equals_pair_by_pair_on_bunny_2k_with_internal_overdraw() {
-    let Some(mesh) = common::real_mesh("bunny_2k.ply") else { return };
+    let mesh = common::real_mesh("bunny_2k.ply");
     // Runs of the input order are not planar, so clusters also overdraw themselves: the graph
     // must count only what the other cluster changes.
     let graph = assert_same(&mesh, &mesh.triangles, &runs(mesh.triangle_count(), 8), "ico:12", 128);
@@ -97,7 +99,7 @@ fn a_convex_mesh_has_no_arcs() {
 }
 
 /// The least backward weight any order of `n` nodes achieves (dynamic programming over subsets).
-fn optimal_backward_weight(n: usize, arcs: &[triorder::order::overdraw_graph::Arc]) -> u64 {
+fn optimal_backward_weight(n: usize, arcs: &[triorder::order::nehab::overdraw_graph::Arc]) -> u64 {
     let mut best = vec![u64::MAX; 1 << n];
     best[0] = 0;
     for set in 0..(1usize << n) {
@@ -139,17 +141,15 @@ fn helix_twists_make_the_graph_cyclic_and_the_greedy_order_breaks_little() {
 /// them) to bottom, so that seen from +z no fragment is shaded twice.
 #[test]
 fn nehab_recovers_front_to_back_on_scrambled_layers() {
-    use triorder::order::{self, OrderInput};
+    use triorder::order;
     use triorder::raster::cpu::CpuRaster;
     use triorder::raster::{RasterBackend, views};
-    use triorder::topology::Topology;
     let layers = generate("layers:6");
     let shuffle = [3usize, 0, 5, 1, 4, 2];
     let order: Vec<u32> = shuffle.iter().flat_map(|&l| [2 * l as u32, 2 * l as u32 + 1]).collect();
     let mesh = layers.reordered(&order);
-    let topology = Topology::new(&mesh);
     let nehab = order::resolve("nehab:clusters=6,views=162,res=64", 0).unwrap();
-    let result = order::run(&nehab, &OrderInput { mesh: &mesh, topology: &topology }).unwrap();
+    let result = common::static_order(&nehab, &mesh).unwrap();
     // Triangle t of `mesh` lies on layer shuffle[t / 2].
     let drawn_layers: Vec<usize> = result.iter().step_by(2).map(|&t| shuffle[t as usize / 2]).collect();
     assert_eq!(drawn_layers, [5, 4, 3, 2, 1, 0]);
@@ -162,19 +162,20 @@ fn nehab_recovers_front_to_back_on_scrambled_layers() {
 /// overdraw within 2% of `meshopt-overdraw` or better (the full 162-view, 512² comparison on
 /// every model is `experiments/nbs06-fig8-overdraw-bars.toml`; this is its small-model check).
 #[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn sander07_overdraw_is_within_two_percent_of_meshopts() {
-    use triorder::eval::{MeasureOptions, evaluate};
-    use triorder::topology::Topology;
+    use triorder::measure::{MeasureOptions, evaluate};
+    use triorder::mesh::Scene;
     let options =
         MeasureOptions { caches: vec![], views: Some(ViewSet::Ico(162)), res: 256, seed: 0, ..Default::default() };
-    let cpu = triorder::raster::backend("cpu").unwrap();
+    let cpu = triorder::measure::backend("cpu").unwrap();
     for name in ["bunny_2k.ply", "dragon_vrip_res4.ply", "pirate.obj", "spot.obj"] {
-        let Some(mesh) = common::real_mesh(name) else { return };
-        let topology = Topology::new(&mesh);
+        let mesh = common::real_mesh(name);
+        let scene = Scene::still(mesh);
         let mean = |spec: &str| {
             let method = triorder::order::resolve(spec, 0).unwrap();
-            let eval = evaluate(&mesh, &topology, &method, &options, cpu.as_ref()).unwrap();
-            eval.measurement.overdraw.unwrap().summary.unwrap().mean
+            let eval = evaluate(&scene, &method, &options, cpu.as_ref()).unwrap();
+            eval.summary("ovr_mean").unwrap()
         };
         let (ours, theirs) = (mean("sander07"), mean("meshopt-overdraw"));
         assert!(ours <= 1.02 * theirs, "{name}: sander07 {ours}, meshopt-overdraw {theirs}");

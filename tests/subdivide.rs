@@ -8,8 +8,8 @@ use glam::{Mat4, Quat, Vec3};
 use triorder::mesh::animated::{Animated, Clip, Pose};
 use triorder::mesh::procedural::generate;
 use triorder::mesh::subdivide::loop_subdivide;
+use triorder::mesh::topology::Topology;
 use triorder::mesh::{Mesh, VertexAttributes};
-use triorder::topology::Topology;
 
 fn make(spec: &str) -> Mesh {
     generate(spec, 0).expect("a procedural spec").expect("a valid spec")

@@ -4,16 +4,17 @@ use std::path::Path;
 
 use triorder::Result;
 use triorder::experiment::{self, RunOptions, provenance};
-use triorder::figure::{self, PlotOptions};
-use triorder::mesh::source;
-use triorder::raster;
+use triorder::figure::PlotOptions;
+use triorder::mesh::{Source, source};
+use triorder::reproduce;
+use triorder::{measure, raster};
 
 use crate::{BenchPart, Common};
 
 /// Options for `run` and `reproduce`; an unknown backend fails here, before any spec runs.
 fn run_options(quick: bool, backend: Option<String>, common: &Common) -> Result<RunOptions> {
     if let Some(name) = &backend {
-        raster::check_backend_name(name)?;
+        measure::check_backend_name(name)?;
     }
     Ok(RunOptions { quick, data: common.data.clone(), progress: true, backend, ..Default::default() })
 }
@@ -24,14 +25,15 @@ pub fn run(spec: &Path, quick: bool, backend: Option<String>, common: &Common) -
     Ok(())
 }
 
-pub fn plot(spec: &Path, quick: bool) -> Result<()> {
-    let svg = figure::plot(spec, &PlotOptions { quick, ..Default::default() })?;
+pub fn plot(spec: &Path, quick: bool, common: &Common) -> Result<()> {
+    let svg = reproduce::plot(spec, &PlotOptions { quick, data: common.data.clone(), ..Default::default() })?;
     println!("wrote {}", svg.display());
     Ok(())
 }
 
 pub fn reproduce(quick: bool, only: Option<&str>, backend: Option<String>, common: &Common) -> Result<()> {
-    for (csv, svg) in experiment::reproduce(&run_options(quick, backend, common)?, only)? {
+    let outcome = reproduce::reproduce(&run_options(quick, backend, common)?, only)?;
+    for (_, csv, svg) in &outcome.ran {
         println!("wrote {} and {}", csv.display(), svg.display());
     }
     Ok(())
@@ -48,21 +50,27 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
     let defaults: &[&str] = if data.is_some() { &BENCH_MODELS } else { &BENCH_FALLBACK };
     let models: Vec<&str> =
         if meshes.is_empty() { defaults.to_vec() } else { meshes.iter().map(String::as_str).collect() };
-    let meshes = models
+    let scenes = models
         .iter()
-        .map(|model| source::open(model, data.as_deref(), common.seed).map(|mesh| (*model, mesh)))
+        .map(|model| Source::parse(model)?.open(data.as_deref(), common.seed).map(|scene| (*model, scene)))
         .collect::<Result<Vec<_>>>()?;
     println!("machine: {}", provenance::machine());
     println!("median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster)");
     if only == Some(BenchPart::Backends) {
-        let gpu = raster::backend("gpu")?;
+        let gpu = measure::backend("gpu")?;
         println!("\noverdraw counting, GPU backend vs CPU (ratio = GPU time / CPU time; < 1: the GPU is faster)");
         println!(
             "{:<28} {:>9}  {:<14} {:>10} {:>10} {:>8}  device",
             "mesh", "triangles", "views", "cpu ms", "gpu ms", "ratio"
         );
-        for (model, mesh) in &meshes {
-            let r = triorder::bench::compare_backends(mesh, gpu.as_ref(), raster::ViewSet::Ico(162), 512, reps)?;
+        for (model, scene) in &scenes {
+            let r = triorder::experiment::bench::compare_backends(
+                &scene.mesh,
+                gpu.as_ref(),
+                raster::ViewSet::Ico(162),
+                512,
+                reps,
+            )?;
             println!(
                 "{:<28} {:>9}  {:<14} {:>10.1} {:>10.1} {:>7.2}x  {}",
                 model,
@@ -81,8 +89,8 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
             "\n{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",
             "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup"
         );
-        for (model, mesh) in &meshes {
-            for r in triorder::bench::compare(mesh, reps) {
+        for (model, scene) in &scenes {
+            for r in triorder::experiment::bench::compare(&scene.mesh, reps) {
                 let theirs = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.3}", s * 1e3));
                 let speedup = r.speedup().map_or("-".to_string(), |s| format!("{s:.2}x"));
                 println!(
@@ -103,8 +111,8 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
             "{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8} {:>8} {:>8} {:>7}",
             "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup", "ACMR", "meshopt", "ratio"
         );
-        for (model, mesh) in &meshes {
-            for r in triorder::bench::compare_orderings(mesh, reps) {
+        for (model, scene) in &scenes {
+            for r in triorder::experiment::bench::compare_orderings(scene, reps) {
                 let (ours, theirs) = r.acmr.unwrap_or((f64::NAN, f64::NAN));
                 println!(
                     "{:<28} {:>9}  {:<46} {:>10.3} {:>10.3} {:>7.2}x {:>8.4} {:>8.4} {:>7.4}",

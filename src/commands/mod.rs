@@ -8,15 +8,13 @@ pub use experiments::{bench, plot, reproduce, run};
 
 use std::path::Path;
 
-use triorder::eval::{self, MeasureOptions};
 use triorder::gpu::render_time::{MAX_FRAMES, Shading};
-use triorder::mesh::keyframes::Keyframes;
-use triorder::mesh::source::AnimationSource;
-use triorder::mesh::{self, Mesh, report::MeshReport};
-use triorder::metrics::CacheModel;
-use triorder::order::{self, METHODS, params::describe_kind};
-use triorder::raster::{self, RasterBackend, ViewSet};
-use triorder::topology::Topology;
+use triorder::measure::{self, CacheModel, MeasureOptions};
+use triorder::mesh::gltf::animation::ClipSelection;
+use triorder::mesh::source::{self, AnimationSource};
+use triorder::mesh::{Scene, Source};
+use triorder::order::{self, METHODS, Orders, params::describe_kind};
+use triorder::raster::{RasterBackend, ViewSet};
 use triorder::{Error, Result};
 
 use crate::{Animation, Common, Measure};
@@ -29,15 +27,15 @@ struct Measuring {
 
 impl Measuring {
     fn new(m: &Measure, seed: u64) -> Result<Measuring> {
-        let gpu_vertices = m.caches.iter().any(|c| c == eval::GPU_CACHE);
-        let simulated: Vec<&String> = m.caches.iter().filter(|c| *c != eval::GPU_CACHE).collect();
+        let gpu_vertices = m.caches.iter().any(|c| c == measure::GPU_CACHE);
+        let simulated: Vec<&String> = m.caches.iter().filter(|c| *c != measure::GPU_CACHE).collect();
         let caches = if m.caches.is_empty() {
             vec![CacheModel::Fifo(16)]
         } else {
             simulated.into_iter().map(|c| c.parse()).collect::<Result<_>>()?
         };
         let views = m.views.as_deref().map(str::parse::<ViewSet>).transpose()?;
-        let raster = raster::backend(&m.backend)?;
+        let raster = measure::backend(&m.backend)?;
         let render = m.render.iter().map(|s| Shading::parse(s)).collect::<Result<Vec<_>>>()?;
         if !render.is_empty() && views.is_none() {
             return Err(Error::usage("--render times every view of --views: give a view set"));
@@ -51,14 +49,17 @@ impl Measuring {
     }
 }
 
-/// Loads a mesh, derives its topology and prints what is unusual about it on stderr.
-fn open(source: &str, common: &Common) -> Result<(Mesh, Topology)> {
-    let data = mesh::source::data_dir(common.data.as_deref());
-    let mesh = mesh::source::open(source, data.as_deref(), common.seed)?;
-    let topology = Topology::new(&mesh);
-    let report = MeshReport::new(&mesh, &topology);
-    eprintln!("{source}: {report}");
-    Ok((mesh, topology))
+/// Opens `source`, printing what is unusual about the mesh (and an animation's clips) on stderr.
+fn open(source: &Source, common: &Common) -> Result<Scene> {
+    let data = source::data_dir(common.data.as_deref());
+    let scene = source.open(data.as_deref(), common.seed)?;
+    let mut line = format!("{source}: {}", scene.report());
+    if scene.frames.animated {
+        let clips: Vec<String> = scene.frames.clips.iter().map(|(n, r)| format!("{n} ({} frames)", r.len())).collect();
+        line = format!("{line}; clips: {}", clips.join(", "));
+    }
+    eprintln!("{line}");
+    Ok(scene)
 }
 
 pub fn methods() -> Result<()> {
@@ -86,82 +87,47 @@ pub fn eval(
     let specs: Vec<&str> =
         if methods.is_empty() { vec!["input"] } else { methods.iter().map(String::as_str).collect() };
     let resolved = specs.iter().map(|s| order::resolve(s, common.seed)).collect::<Result<Vec<_>>>()?;
-    let animation = animation_source(source, animation)?;
-    if animation.is_some() || resolved.iter().any(|r| r.method.per_node) {
-        return eval_nodes(source, animation, &resolved, &measuring, json, common);
-    }
-    let (mesh, topology) = open(source, common)?;
-    let mut table = tables::EvalTable::new(&measuring.options);
+    let source = with_animation(Source::parse(source)?, animation)?;
+    let scene = open(&source, common)?;
+    let buffers = scene.frames.animated || resolved.iter().any(|r| r.method.per_node);
+    let mut table = tables::EvalTable::new(buffers);
     for method in &resolved {
-        let e = eval::evaluate(&mesh, &topology, method, &measuring.options, measuring.raster.as_ref())?;
+        let e = measure::evaluate(&scene, method, &measuring.options, measuring.raster.as_ref())?;
         if json {
-            println!("{}", tables::eval_json(&mesh, &e, &measuring.raster.describe()));
+            println!("{}", tables::eval_json(&scene, &e, &measuring.raster.describe()));
         } else {
             table.push(&e);
         }
     }
     if !json {
-        print!("{}", table.render(&mesh));
+        print!("{}", table.render(&scene.mesh));
     }
     Ok(())
 }
 
-/// The animation `source` and the `--clip`/`--frames`/`--subdiv` options name, if any.
-fn animation_source(source: &str, options: &Animation) -> Result<Option<AnimationSource>> {
-    let given = options.clip.is_some() || options.frames.is_some() || options.subdiv.is_some();
-    if !given {
-        return AnimationSource::parse(source).transpose();
+/// `source` as the animation the `--clip`/`--frames`/`--subdiv` options name, if they name one.
+fn with_animation(source: Source, options: &Animation) -> Result<Source> {
+    if options.clip.is_none() && options.frames.is_none() && options.subdiv.is_none() {
+        return Ok(source);
     }
-    if source.contains('#') {
-        return Err(Error::usage(format!(
-            "`{source}` names its animation after `#`; drop --clip, --frames and --subdiv"
-        )));
-    }
-    let mut keys = vec![format!("clip={}", options.clip.as_deref().unwrap_or("all"))];
-    keys.extend(options.frames.map(|n| format!("frames={n}")));
-    keys.extend(options.subdiv.map(|l| format!("subdiv={l}")));
-    AnimationSource::parse(&format!("{source}#{}", keys.join(","))).transpose()
-}
-
-/// `eval` through index buffers per (keyframe, view): an animation, or a static mesh as one
-/// frame when a method is keyframe- or view-dependent.
-fn eval_nodes(
-    source: &str,
-    animation: Option<AnimationSource>,
-    methods: &[order::Resolved],
-    measuring: &Measuring,
-    json: bool,
-    common: &Common,
-) -> Result<()> {
-    let (mesh, topology, keyframes) = match animation {
-        Some(animation) => {
-            let data = mesh::source::data_dir(common.data.as_deref());
-            let (mesh, keyframes) = animation.open(data.as_deref())?;
-            let topology = Topology::new(&mesh);
-            let clips: Vec<String> = keyframes.clips.iter().map(|(n, r)| format!("{n} ({} frames)", r.len())).collect();
-            eprintln!("{source}: {}; clips: {}", MeshReport::new(&mesh, &topology), clips.join(", "));
-            (mesh, topology, keyframes)
+    let path = match source {
+        Source::File(path) => path,
+        Source::Animation(_) => {
+            return Err(Error::usage(format!(
+                "`{source}` names its animation after `#`; drop --clip, --frames and --subdiv"
+            )));
         }
-        None => {
-            let (mesh, topology) = open(source, common)?;
-            let keyframes = Keyframes::still(&mesh);
-            (mesh, topology, keyframes)
-        }
+        other => return Err(Error::usage(format!("`{other}`: --clip, --frames and --subdiv are for a glTF/GLB file"))),
     };
-    let mut table = tables::EvalTable::with_buffers(&measuring.options);
-    for method in methods {
-        let e =
-            eval::evaluate_nodes(&mesh, &topology, &keyframes, method, &measuring.options, measuring.raster.as_ref())?;
-        if json {
-            println!("{}", tables::nodes_json(&mesh, &keyframes, &e, &measuring.raster.describe()));
-        } else {
-            table.push_nodes(&e);
-        }
-    }
-    if !json {
-        print!("{}", table.render(&mesh));
-    }
-    Ok(())
+    let frames = options
+        .frames
+        .map(source::check_frames)
+        .transpose()
+        .map_err(|why| Error::usage(format!("--frames {} {why}", options.frames.unwrap_or_default())))?;
+    let subdiv = source::check_subdiv(options.subdiv.unwrap_or(0))
+        .map_err(|why| Error::usage(format!("--subdiv {} {why}", options.subdiv.unwrap_or_default())))?;
+    let clip = options.clip.clone().filter(|c| c != "all");
+    Ok(Source::Animation(AnimationSource { path, selection: ClipSelection { clip, frames }, subdiv }))
 }
 
 pub fn order(
@@ -175,9 +141,10 @@ pub fn order(
     let measuring = Measuring::new(measure, common.seed)?;
     let resolved = order::resolve(method, common.seed)?;
     if resolved.method.per_node {
-        return Err(order::needs_nodes(resolved.method.name));
+        return Err(order::needs_one_order(resolved.method.name, "`order` cannot write it"));
     }
-    if AnimationSource::parse(source).is_some() {
+    let source = Source::parse(source)?;
+    if source.is_animation() {
         return Err(Error::usage(format!(
             "`{source}`: `order` writes a static mesh and would drop the animation; \
              name the file without `#...` to reorder its rest mesh"
@@ -186,22 +153,24 @@ pub fn order(
     if output.is_dir() {
         return Err(Error::output(output, "is a directory"));
     }
-    if mesh::save::format_of(output).is_none() {
+    if triorder::mesh::save::format_of(output).is_none() {
         return Err(Error::output(output, "unknown output format (use .obj, .ply or .glb)"));
     }
-    let (mesh, topology) = open(source, common)?;
-    let identity: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
-    let before = eval::measure(&mesh, &identity, &measuring.options, measuring.raster.as_ref())?;
-    let after = eval::evaluate(&mesh, &topology, &resolved, &measuring.options, measuring.raster.as_ref())?;
-    let mut reordered = mesh.reordered(&after.order);
+    let scene = open(&source, common)?;
+    let identity: Vec<u32> = (0..scene.mesh.triangle_count() as u32).collect();
+    let before = measure::measure(&scene, &Orders::from(identity), &measuring.options, measuring.raster.as_ref())?;
+    let after = measure::evaluate(&scene, &resolved, &measuring.options, measuring.raster.as_ref())?;
+    let buffer =
+        after.orders.single().ok_or_else(|| order::needs_one_order(after.method_name, "`order` cannot write it"))?;
+    let mut reordered = scene.mesh.reordered(&buffer.order);
     if remap_vertices {
         reordered = reordered.remap_vertices_first_use();
     }
-    let saved = mesh::save::save(&reordered, output)?;
+    let saved = triorder::mesh::save::save(&reordered, output)?;
     for dropped in &saved.dropped {
         eprintln!("warning: {}: not written: {dropped}", output.display());
     }
-    println!("{}", tables::before_after(&before, &after));
+    println!("{}", tables::before_after(&before, &after.measured));
     println!(
         "wrote {} ({} triangles, {} ordered in {:.3} s)",
         output.display(),

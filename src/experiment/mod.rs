@@ -1,11 +1,11 @@
-//! Experiments: a TOML spec per paper figure ([`spec`]) is run into a tidy results CSV
-//! ([`row`]), which [`crate::figure`] draws. `triorder run`, `plot` and `reproduce` are thin
-//! wrappers around [`run`], [`crate::figure::plot`] and [`reproduce`].
+//! Experiments: a TOML spec per paper figure ([`spec`]) is run into a tidy results CSV (the
+//! contract in [`crate::results`]), which [`crate::figure`] draws; [`crate::reproduce`] does both
+//! for every spec. [`bench`] times our metrics and orderings against meshoptimizer.
 
+pub mod bench;
 pub mod provenance;
-pub mod row;
-mod run;
+pub mod run;
 pub mod spec;
 
-pub use run::{RunOptions, reproduce, run};
+pub use run::{RunOptions, run};
 pub use spec::Spec;

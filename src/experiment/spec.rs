@@ -82,15 +82,14 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::row::{COLUMNS, METRICS, Needs};
 use crate::error::{Error, Result};
-use crate::eval::GPU_CACHE;
+use crate::figure::spec::{Figure, FigureKind, RawFigure, Writes, kind_name};
+use crate::figure::{Chart, PlotOptions};
 use crate::gpu::render_time::{MAX_FRAMES, Shading};
-use crate::mesh::source::AnimationSource;
-use crate::mesh::{procedural, simplify};
-use crate::metrics::CacheModel;
+use crate::measure::{self, CacheModel, GPU_CACHE, MeasureOptions};
+use crate::mesh::Source;
 use crate::order::{self, METHODS};
-use crate::raster::{self, ViewSet};
+use crate::raster::ViewSet;
 
 /// Overdraw image size when a spec gives views but no `res` (Nehab et al. 2006 use 512×512).
 pub const DEFAULT_RES: u32 = 512;
@@ -130,103 +129,22 @@ pub struct Spec {
     pub figure: Figure,
 }
 
+/// A model as the spec names it (the name results record) and what it names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Model {
+    pub name: String,
+    pub source: Source,
+}
+
 /// The models and measurements of one run (full or quick).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Workload {
-    pub models: Vec<String>,
+    pub models: Vec<Model>,
     pub caches: Vec<CacheModel>,
     /// The caches list names [`GPU_CACHE`]: count vertex-shader invocations on the GPU too.
     pub gpu_vertices: bool,
     pub views: Option<ViewSet>,
     pub res: u32,
-}
-
-/// How the figure is drawn from the CSV.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Figure {
-    pub kind: FigureKind,
-    /// The first of [`Figure::metrics`]: the one that names the y axis.
-    pub metric: String,
-    /// Every metric drawn; with more than one, `series` or `facet` is `metric`.
-    pub metrics: Vec<String>,
-    pub x: Option<String>,
-    pub series: String,
-    pub facet: Option<String>,
-    /// `(column, value)` pairs a row must match to be drawn.
-    pub filter: Vec<(String, String)>,
-    pub x_label: Option<String>,
-    pub y_label: Option<String>,
-    pub x_log: bool,
-    pub y_log: bool,
-    pub y_range: Option<(f64, f64)>,
-    /// Bars: `metric:NAME`, the metric written above each bar instead of its value (e.g. the
-    /// iterations an ordering took above its time, Han & Sander 2017 Fig. 5).
-    pub label: Option<String>,
-    /// Drawing kinds: the direction the model is seen from (centre → eye), default +z.
-    pub view: [f32; 3],
-    /// Kind `ratio`: the method names whose values are divided, numerator first.
-    pub ratio: Option<(String, String)>,
-}
-
-/// The chart kinds `triorder plot` draws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum FigureKind {
-    /// y against a numeric x, one line per series (e.g. ACMR against cache size).
-    Line,
-    /// y against a numeric x, one point per row (e.g. ACMR against ordering time).
-    Scatter,
-    /// Grouped bars: categories on x, one bar per series in each group.
-    Bar,
-    /// Every value of each series sorted ascending (a quantile curve) with its mean dashed, and
-    /// mean, max and variance written in the chart: for per-view overdraw.
-    Distribution,
-    /// A table of numbers: one row per x value, one column per series (the papers' tables).
-    Table,
-    /// Each (model, method) drawn as its triangles coloured by position in the sequence, with the
-    /// path through their centroids (Bogomjakov & Gotsman 2002, Figs. 2 and 4). Needs the
-    /// orders, which runs of drawing specs save next to the CSV.
-    Sequence,
-    /// Each (model, method, cache) drawn with every triangle corner coloured by whether its vertex
-    /// hit, was loaded the first time, or reloaded (Bogomjakov & Gotsman 2002, Figs. 10 and 11).
-    Corners,
-    /// Each (model, method) drawn with its clusters in distinct colours (Nehab et al. 2006, Fig. 3).
-    Clusters,
-    /// Each (model, method) drawn with its clusters shaded black (drawn first) to white (drawn
-    /// last) (Nehab et al. 2006, Fig. 6).
-    #[serde(rename = "cluster-order")]
-    ClusterOrder,
-    /// Each (model, method) drawn as a heat map of the fragments shaded at each pixel from the
-    /// figure's view: darker, more overdraw (Nehab et al. 2006, Fig. 1).
-    Overdraw,
-    /// Which simulated cache model predicts the vertex-shader invocations counted on the GPU
-    /// (caches must list simulated models and `gpu`): every model ranked by its error, and the
-    /// winner's simulated against counted ACMR (issue 6).
-    #[serde(rename = "hardware-fit")]
-    HardwareFit,
-    /// Per view, one method's value over another's (`ratio = [A, B]`) of the x metric against
-    /// that of the y metric, with Pearson's r per series (Nehab et al. 2006, Fig. 10: overdraw
-    /// ratio against render-time ratio, nehab over hoppe).
-    Ratio,
-}
-
-impl FigureKind {
-    /// Kinds whose layout is their own: they read `acmr` rows and take no x or log axes.
-    pub fn fixed_layout(self) -> bool {
-        self.draws_meshes() || self == FigureKind::HardwareFit
-    }
-
-    /// Kinds that draw the meshes themselves and so need the orders saved by the run.
-    pub fn draws_meshes(self) -> bool {
-        matches!(
-            self,
-            FigureKind::Sequence
-                | FigureKind::Corners
-                | FigureKind::Clusters
-                | FigureKind::ClusterOrder
-                | FigureKind::Overdraw
-        )
-    }
 }
 
 impl Spec {
@@ -243,6 +161,41 @@ impl Spec {
             (false, _) => Ok(&self.full),
             (true, Some(quick)) => Ok(quick),
             (true, None) => Err(Error::spec(&self.path, "has no [quick] table, so it cannot run with --quick")),
+        }
+    }
+
+    /// What a run of `work` measures.
+    pub fn measure_options(&self, work: &Workload) -> MeasureOptions {
+        MeasureOptions {
+            caches: work.caches.clone(),
+            gpu_vertices: work.gpu_vertices,
+            views: work.views,
+            res: work.res,
+            seed: self.seed,
+            render: self.render.clone(),
+            render_frames: self.render_frames,
+        }
+    }
+
+    /// Whether the spec asks for a GPU itself (its backend or a metric), in either run.
+    pub fn needs_gpu(&self) -> bool {
+        let needs = |w: &Workload| self.measure_options(w).needs_gpu();
+        self.backend == "gpu" || needs(&self.full) || self.quick.as_ref().is_some_and(needs)
+    }
+
+    /// What the figure is drawn from, under `opts`.
+    pub fn chart(&self, opts: &PlotOptions) -> Chart<'_> {
+        Chart {
+            figure: &self.figure,
+            spec: &self.path,
+            title: &self.title,
+            claim: self.claim.as_deref(),
+            csv: self.csv_path(&opts.out_dir, opts.quick),
+            orders: self.orders_path(&opts.out_dir, opts.quick),
+            svg: self.svg_path(&opts.out_dir, opts.quick),
+            quick: opts.quick,
+            data: opts.data.clone(),
+            seed: self.seed,
         }
     }
 
@@ -324,36 +277,6 @@ impl<'de> Deserialize<'de> for RawMethods {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawFigure {
-    kind: FigureKind,
-    metric: OneOrMany,
-    x: Option<String>,
-    series: Option<String>,
-    facet: Option<String>,
-    #[serde(default)]
-    filter: toml::Table,
-    x_label: Option<String>,
-    y_label: Option<String>,
-    #[serde(default)]
-    x_log: bool,
-    #[serde(default)]
-    y_log: bool,
-    y_range: Option<[f64; 2]>,
-    label: Option<String>,
-    view: Option<[f32; 3]>,
-    ratio: Option<[String; 2]>,
-}
-
-/// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum OneOrMany {
-    One(String),
-    Many(Vec<String>),
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawQuick {
     models: Vec<String>,
     caches: Option<Vec<String>>,
@@ -381,7 +304,7 @@ impl RawSpec {
         }
         let methods = check_methods(&self.methods, self.seed).map_err(err)?;
         let backend = self.backend.unwrap_or_else(|| "cpu".into());
-        raster::check_backend_name(&backend).map_err(|e| err(format!("backend: {e}")))?;
+        crate::measure::check_backend_name(&backend).map_err(|e| err(format!("backend: {e}")))?;
 
         let full = check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res).map_err(err)?;
         let quick = match &self.quick {
@@ -391,26 +314,15 @@ impl RawSpec {
                 let views = q.views.as_deref().or(self.views.as_deref());
                 let res = q.res.or(self.res);
                 let work = check_workload("quick.", &q.models, caches, views, res).map_err(err)?;
-                if let Some((i, model)) = work.models.iter().enumerate().find(|(_, m)| !is_bundled(m)) {
+                if let Some((i, model)) = work.models.iter().enumerate().find(|(_, m)| !m.source.is_bundled()) {
                     return Err(err(format!(
-                        "quick.models[{i}] `{model}`: quick runs use procedural models and files under assets/ only, so they work on a fresh clone"
+                        "quick.models[{i}] `{}`: quick runs use procedural models and files under assets/ only, so they work on a fresh clone",
+                        model.name
                     )));
                 }
                 Some(work)
             }
         };
-        let figure = self.figure.check(&full, &methods).map_err(err)?;
-        let per_node = methods.iter().find(|m| order::resolve(m, self.seed).is_ok_and(|r| r.method.per_node));
-        let animated = full.models.iter().chain(quick.iter().flat_map(|q| &q.models)).find(|m| is_animation(m));
-        let gpu_vertices = full.gpu_vertices || quick.as_ref().is_some_and(|q| q.gpu_vertices);
-        // What gives an index buffer per (keyframe, view), if anything does.
-        let per_node = per_node.map(|m| format!("method `{m}`")).or(animated.map(|m| format!("model `{m}`")));
-        let fits = |w: &Workload| w.gpu_vertices && !w.caches.is_empty();
-        if figure.kind == FigureKind::HardwareFit && !(fits(&full) && quick.as_ref().is_none_or(fits)) {
-            return Err(err(format!(
-                "figure.kind = \"hardware-fit\" compares simulated caches with the GPU's counts: caches must list simulated models and `{GPU_CACHE}`"
-            )));
-        }
         let render = self
             .render
             .iter()
@@ -421,32 +333,34 @@ impl RawSpec {
         if !(1..=MAX_FRAMES).contains(&render_frames) {
             return Err(err(format!("render_frames = {render_frames} is not in 1..={MAX_FRAMES}")));
         }
-        for metric in &figure.metrics {
-            let rendered = metric.strip_prefix("render_ms_").or(metric.strip_prefix("render_spread_"));
-            let shading = rendered.map(|s| s.trim_end_matches("_view"));
-            if let Some(shading) = shading.and_then(|s| Shading::parse(s).ok())
-                && !render.contains(&shading)
-            {
-                return Err(err(format!("figure.metric = \"{metric}\" needs render = [\"{}\"]", shading.name())));
-            }
+        if !render.is_empty() && (full.views.is_none() || quick.as_ref().is_some_and(|q| q.views.is_none())) {
+            return Err(err("render times every view of `views`: set views".into()));
         }
-        if !render.is_empty() {
-            if full.views.is_none() || quick.as_ref().is_some_and(|q| q.views.is_none()) {
-                return Err(err("render times every view of `views`: set views".into()));
-            }
-            if let Some(what) = &per_node {
-                return Err(err(format!(
-                    "render times one index buffer per model and method on the GPU, but {what} gives an index buffer per (keyframe, view)"
-                )));
-            }
-        }
-        if gpu_vertices && let Some(what) = &per_node {
+        let options = MeasureOptions {
+            caches: full.caches.clone(),
+            gpu_vertices: full.gpu_vertices,
+            views: full.views,
+            render: render.clone(),
+            ..Default::default()
+        };
+        let writes = Writes {
+            metrics: measure::ORDERING.iter().map(|n| n.name).chain(options.reported()).collect(),
+            methods: &methods,
+            animated: full.models.iter().any(|m| m.source.is_animation()),
+        };
+        let figure = self.figure.check(&writes).map_err(err)?;
+        let fits = |w: &Workload| w.gpu_vertices && !w.caches.is_empty();
+        if figure.kind == FigureKind::HardwareFit && !(fits(&full) && quick.as_ref().is_none_or(fits)) {
             return Err(err(format!(
-                "caches names `{GPU_CACHE}`, which counts one index buffer per model and method on the GPU, but {what} gives an index buffer per (keyframe, view)"
+                "figure.kind = \"hardware-fit\" compares simulated caches with the GPU's counts: caches must list simulated models and `{GPU_CACHE}`"
             )));
         }
+        // Drawings draw one order per model and method.
+        let per_node = methods.iter().find(|m| order::resolve(m, self.seed).is_ok_and(|r| r.method.per_node));
+        let animated = full.models.iter().chain(quick.iter().flat_map(|q| &q.models)).find(|m| m.source.is_animation());
+        let several = per_node.map(|m| format!("method `{m}`")).or(animated.map(|m| format!("model `{}`", m.name)));
         if figure.kind.draws_meshes()
-            && let Some(what) = &per_node
+            && let Some(what) = &several
         {
             return Err(err(format!(
                 "figure.kind = \"{}\" draws one order per model and method, but {what} gives an index buffer per (keyframe, view): use a chart kind (line, bar, table, …)",
@@ -469,17 +383,6 @@ impl RawSpec {
             figure,
         })
     }
-}
-
-/// True for animated models (`PATH#…`).
-fn is_animation(model: &str) -> bool {
-    AnimationSource::parse(model).is_some()
-}
-
-/// True for models a fresh clone has: procedural specs and the bundled `assets/` files.
-fn is_bundled(model: &str) -> bool {
-    let model = simplify::parse_source(model).map_or(model, |(base, _)| base);
-    model.starts_with("assets/") || procedural::check(model).is_some()
 }
 
 /// Expands and resolves the method list; the canonical specs, deduplicated, in order.
@@ -529,11 +432,14 @@ fn check_workload(
     if let Some((i, _)) = models.iter().enumerate().find(|(_, m)| m.trim().is_empty()) {
         return Err(format!("{prefix}models[{i}] is empty"));
     }
-    for (i, model) in models.iter().enumerate() {
-        if let Some(Err(e)) = AnimationSource::parse(model) {
-            return Err(format!("{prefix}models[{i}]: {e}"));
-        }
-    }
+    let models = models
+        .iter()
+        .enumerate()
+        .map(|(i, name)| match Source::parse(name) {
+            Ok(source) => Ok(Model { name: name.clone(), source }),
+            Err(e) => Err(format!("{prefix}models[{i}]: {e}")),
+        })
+        .collect::<std::result::Result<Vec<_>, _>>()?;
     let mut parsed = Vec::new();
     let gpu_vertices = caches.iter().any(|c| c == GPU_CACHE);
     for (i, text) in caches.iter().enumerate().filter(|(_, c)| *c != GPU_CACHE) {
@@ -559,194 +465,7 @@ fn check_workload(
     if parsed.is_empty() && !gpu_vertices && views.is_none() {
         return Err(format!("{prefix}caches is empty and views is not set: nothing to measure but time"));
     }
-    Ok(Workload { models: models.to_vec(), caches: parsed, gpu_vertices, views, res })
-}
-
-impl RawFigure {
-    fn check(self, full: &Workload, methods: &[String]) -> std::result::Result<Figure, String> {
-        let metrics = match self.metric {
-            OneOrMany::One(m) => vec![m],
-            OneOrMany::Many(ms) if ms.is_empty() => return Err("figure.metric is an empty list".into()),
-            OneOrMany::Many(ms) => ms,
-        };
-        for name in &metrics {
-            let metric = METRICS.iter().find(|m| m.name == name).ok_or_else(|| {
-                let known: Vec<_> = METRICS.iter().map(|m| m.name).collect();
-                format!("figure.metric `{name}` is not a metric the CSV has (metrics: {})", known.join(", "))
-            })?;
-            match metric.needs {
-                Needs::Caches if full.caches.is_empty() && !full.gpu_vertices => {
-                    return Err(format!("figure.metric = \"{}\" needs `caches`", metric.name));
-                }
-                Needs::Views if full.views.is_none() => {
-                    return Err(format!("figure.metric = \"{}\" needs `views`", metric.name));
-                }
-                _ => {}
-            }
-        }
-        let metric = metrics[0].clone();
-        if metrics.len() > 1 && self.series.as_deref() != Some("metric") && self.facet.as_deref() != Some("metric") {
-            return Err("figure.metric lists several metrics: set figure.series or figure.facet to \"metric\"".into());
-        }
-        // A CSV column; `param:NAME`, a parameter of the spec's methods; `source:KEY`, a key of its
-        // animated models; or, where `metric_ok`, `metric:NAME`, another metric joined on model
-        // and method.
-        let column = |key: &str, name: &str, metric_ok: bool| {
-            if let Some(source_key) = name.strip_prefix("source:") {
-                if !crate::figure::data::SOURCE_KEYS.contains(&source_key) {
-                    return Err(format!(
-                        "{key} `{name}`: `{source_key}` is not a key of an animated model (keys: {})",
-                        crate::figure::data::SOURCE_KEYS.join(", ")
-                    ));
-                }
-                if !full.models.iter().any(|m| is_animation(m)) {
-                    return Err(format!("{key} `{name}`: no model of this spec is an animation (PATH#…)"));
-                }
-                return Ok(());
-            }
-            if let Some(param) = name.strip_prefix("param:") {
-                if methods.iter().any(|m| crate::figure::data::parameter(m, param).is_some()) {
-                    return Ok(());
-                }
-                return Err(format!("{key} `{name}`: no method of this spec has a parameter `{param}`"));
-            }
-            if let Some(other) = name.strip_prefix("metric:").filter(|_| metric_ok) {
-                if METRICS.iter().any(|m| m.name == other) {
-                    return Ok(());
-                }
-                return Err(format!("{key} `{name}`: `{other}` is not a metric"));
-            }
-            if COLUMNS.contains(&name) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "{key} `{name}` is not a CSV column (columns: {}; or param:NAME, source:KEY{})",
-                    COLUMNS.join(", "),
-                    if metric_ok { ", metric:NAME" } else { "" }
-                ))
-            }
-        };
-        let view = match (self.kind.draws_meshes(), self.view) {
-            (false, Some(_)) => return Err("figure.view is only for the kinds that draw meshes".into()),
-            (true, Some(v)) if !(v.iter().all(|c| c.is_finite()) && v.iter().any(|&c| c != 0.0)) => {
-                return Err(format!("figure.view = {v:?} must be a finite, non-zero direction"));
-            }
-            (_, v) => v.unwrap_or([0.0, 0.0, 1.0]),
-        };
-        if self.kind.fixed_layout() && metrics != ["acmr"] {
-            return Err(format!(
-                "figure.metric = {metrics:?}: kind = \"{}\" reads ACMR, so metric must be \"acmr\"",
-                kind_name(self.kind)
-            ));
-        }
-        match (self.kind, &self.x) {
-            (k, Some(_)) if k.fixed_layout() => {
-                return Err(format!("figure.x is not used by kind = \"{}\": remove it", kind_name(k)));
-            }
-            (k, None) if k.fixed_layout() => {}
-            (FigureKind::Distribution, Some(_)) => {
-                return Err(
-                    "figure.x is not used by kind = \"distribution\" (it sorts the values itself): remove it".into()
-                );
-            }
-            (FigureKind::Distribution, None) => {}
-            (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
-            (k, Some(x)) => column("figure.x", x, matches!(k, FigureKind::Scatter | FigureKind::Ratio))?,
-        }
-        if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.fixed_layout()) {
-            return Err(format!("figure.x_log / y_log: kind = \"{}\" has no axes", kind_name(self.kind)));
-        }
-        if self.x_log && matches!(self.kind, FigureKind::Bar | FigureKind::Distribution) {
-            return Err(format!("figure.x_log: kind = \"{}\" has no numeric x axis", kind_name(self.kind)));
-        }
-        let series = self.series.unwrap_or_else(|| "method".into());
-        column("figure.series", &series, false)?;
-        if let Some(facet) = &self.facet {
-            column("figure.facet", facet, false)?;
-        }
-        let mut filter = Vec::new();
-        for (key, value) in self.filter {
-            column("figure.filter key", &key, false)?;
-            let value = match value {
-                toml::Value::String(s) => s,
-                toml::Value::Integer(i) => i.to_string(),
-                toml::Value::Boolean(b) => b.to_string(),
-                other => return Err(format!("figure.filter.{key} = {other}: expected a string, integer or boolean")),
-            };
-            filter.push((key, value));
-        }
-        if let Some(label) = &self.label {
-            if self.kind != FigureKind::Bar {
-                return Err(format!("figure.label is for kind = \"bar\", not \"{}\"", kind_name(self.kind)));
-            }
-            if !label.starts_with("metric:") {
-                return Err(format!("figure.label `{label}`: expected metric:NAME"));
-            }
-            column("figure.label", label, true)?;
-        }
-        let ratio = match (self.kind, self.ratio) {
-            (FigureKind::Ratio, None) => {
-                return Err("figure.ratio = [A, B] (method names) is required for kind = \"ratio\"".into());
-            }
-            (FigureKind::Ratio, Some([a, b])) => {
-                let names: Vec<&str> = methods.iter().map(|m| m.split(':').next().unwrap_or(m)).collect();
-                if let Some(missing) = [&a, &b].into_iter().find(|n| !names.contains(&n.as_str())) {
-                    return Err(format!("figure.ratio names `{missing}`, which is not a method of this spec"));
-                }
-                if !self.x.as_deref().is_some_and(|x| x.starts_with("metric:")) || metrics.len() != 1 {
-                    return Err("kind = \"ratio\" needs x = \"metric:NAME\" and one metric, both per view".into());
-                }
-                Some((a, b))
-            }
-            (_, Some(_)) => {
-                return Err(format!("figure.ratio is for kind = \"ratio\", not \"{}\"", kind_name(self.kind)));
-            }
-            (_, None) => None,
-        };
-        let y_range = match self.y_range {
-            Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
-                return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
-            }
-            Some([lo, _]) if self.y_log && lo <= 0.0 => {
-                return Err(format!("figure.y_range starts at {lo}, but a log axis needs values > 0"));
-            }
-            r => r.map(|[lo, hi]| (lo, hi)),
-        };
-        Ok(Figure {
-            kind: self.kind,
-            metric,
-            metrics,
-            x: self.x,
-            series,
-            facet: self.facet,
-            filter,
-            x_label: self.x_label,
-            y_label: self.y_label,
-            x_log: self.x_log,
-            y_log: self.y_log,
-            y_range,
-            label: self.label,
-            view,
-            ratio,
-        })
-    }
-}
-
-fn kind_name(kind: FigureKind) -> &'static str {
-    match kind {
-        FigureKind::Line => "line",
-        FigureKind::Scatter => "scatter",
-        FigureKind::Bar => "bar",
-        FigureKind::Distribution => "distribution",
-        FigureKind::Table => "table",
-        FigureKind::Sequence => "sequence",
-        FigureKind::Clusters => "clusters",
-        FigureKind::ClusterOrder => "cluster-order",
-        FigureKind::Overdraw => "overdraw",
-        FigureKind::Corners => "corners",
-        FigureKind::HardwareFit => "hardware-fit",
-        FigureKind::Ratio => "ratio",
-    }
+    Ok(Workload { models, caches: parsed, gpu_vertices, views, res })
 }
 
 /// Expands a cache spec: `KIND:LO..HI[/STEP]` is shorthand for `KIND:{LO..HI[/STEP]}`; any

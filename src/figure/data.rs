@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 
 use csv::StringRecord;
 
+use super::spec::{Figure, FigureKind};
 use crate::error::{Error, Result};
-use crate::experiment::row::METRICS;
-use crate::experiment::spec::{Figure, FigureKind};
-use crate::mesh::source::AnimationSource;
+use crate::measure;
+use crate::mesh::Source;
 
 /// A results CSV in memory: its header and its records as text.
 pub struct Table {
@@ -35,21 +35,10 @@ pub struct Series {
     pub labels: Vec<String>,
 }
 
-/// The keys of an animated model (`PATH#clip=NAME,frames=N,subdiv=L`) a figure may read as
-/// `source:KEY`.
-pub const SOURCE_KEYS: &[&str] = &["clip", "frames", "subdiv"];
-
-/// The value of `key` in the animated model `model`, defaults written out (clip `all`, subdiv
-/// `0`); `None` for a static model, a key the model leaves to its keyframes (`frames`), or an
-/// unknown key.
+/// The value of `key` in the animated model `model` (a `model` cell of a results CSV), defaults
+/// written out; see [`Source::key`].
 pub fn source_key(model: &str, key: &str) -> Option<String> {
-    let source = AnimationSource::parse(model)?.ok()?;
-    match key {
-        "clip" => Some(source.selection.clip.unwrap_or_else(|| "all".to_string())),
-        "frames" => source.selection.frames.map(|n| n.to_string()),
-        "subdiv" => Some(source.subdiv.to_string()),
-        _ => None,
-    }
+    Source::parse(model).ok()?.key(key)
 }
 
 impl Table {
@@ -293,7 +282,7 @@ impl Column {
     /// animation key is written `KEY=VALUE` (a bare `1` says nothing about what it counts).
     fn label(&self, record: &StringRecord) -> String {
         let cell = self.cell(record);
-        match (self, METRICS.iter().find(|m| m.name == cell)) {
+        match (self, measure::names().find(|m| m.name == cell)) {
             (Column::Plain(_), Some(m)) => m.label.to_string(),
             (Column::Source(_, key), _) if !cell.is_empty() => format!("{key}={cell}"),
             _ => cell,

@@ -11,12 +11,13 @@
 //!   pixel, same rules as the overdraw counts) into an image embedded in the SVG, so a mesh of any
 //!   size stays legible and small on disk.
 //!
-//! The orders come from the run's orders file and the models' geometry from the data directory;
-//! the ACMR in each title is the results CSV's, and `corners` checks it against the corner counts
-//! it draws, so a figure can never silently show stale orders.
+//! Everything a drawing shows about an order comes from the run: the order and its clusters from
+//! the orders file, the corner classes and the overdraw picture the run saved beside them, the
+//! ACMR in each title from the results CSV (checked against the saved corners, so a figure never
+//! silently shows stale data). The figure itself only lays the mesh out: it reads the models'
+//! geometry and finds the visible triangle at each pixel to paint it.
 
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use base64::Engine;
 use glam::{Vec2, Vec3};
@@ -24,23 +25,20 @@ use plotters::prelude::*;
 
 use super::axes::{self, DrawResult, FONT};
 use super::data::Table;
-use super::{Header, PlotOptions, save};
+use super::spec::FigureKind;
+use super::{Chart, Header, save};
 use crate::error::{Error, Result};
-use crate::experiment::row::OrderRow;
-use crate::experiment::spec::{FigureKind, Spec};
-use crate::mesh::{Mesh, source};
-use crate::metrics::{CacheModel, Corner, cache};
+use crate::measure::Corner;
+use crate::mesh::{Mesh, Source, Topology, source};
 use crate::order;
-use crate::raster::{Framing, cpu, views};
-use crate::topology::Topology;
+use crate::raster::{cpu, views};
+use crate::results::OrderRow;
 
 /// Panel width in pixels; the mesh fills it less a margin, at its own aspect ratio.
 const PANEL_W: u32 = 520;
 const MARGIN: u32 = 10;
 const TITLE_H: u32 = 44;
 const LEGEND_H: u32 = 40;
-/// Corner images are rendered at this many pixels per SVG pixel, so zooming in stays sharp.
-const OVERSAMPLE: f32 = 1.5;
 
 /// Corner colours: hit, first load, first reload, later reloads.
 const HIT: [u8; 3] = [200, 200, 200];
@@ -64,8 +62,9 @@ enum Content {
     Corners(Vec<[Corner; 3]>),
     /// The colour of each drawn triangle's cluster, and which cluster it is in.
     Clusters(Vec<([u8; 3], u32)>),
-    /// Fragments shaded per pixel from the figure's view.
-    Overdraw,
+    /// Fragments shaded at each pixel of the figure's view, as the run saved them
+    /// ([`views::DRAWING_RES`]² pixels, row 0 at the bottom).
+    Overdraw(Vec<u32>),
 }
 
 /// Per drawn triangle: its cluster's colour and index. Distinct colours are golden-ratio hues;
@@ -89,91 +88,122 @@ fn cluster_colours(starts: &[usize], by_rank: bool) -> Vec<([u8; 3], u32)> {
 /// Grey levels of the overdraw heat map: 1, 2, 3, 4 and 5 or more fragments shaded at a pixel.
 const OVERDRAW_GREYS: [u8; 5] = [235, 175, 120, 70, 20];
 
-/// Draws a drawing spec's figure (kind `sequence` or `corners`); returns the SVG's path.
-pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
-    let work = spec.workload(opts.quick)?;
-    let orders_path = spec.orders_path(&opts.out_dir, opts.quick);
-    let orders = read_orders(&orders_path)?;
-    let data = source::data_dir(opts.data.as_deref());
-    let meshes = work.models.iter().map(|m| source::open(m, data.as_deref(), spec.seed)).collect::<Result<Vec<_>>>()?;
-
-    let stale = |what: String| Error::input(orders_path.display(), format!("{what}; rerun the experiment"));
+/// Draws a drawing spec's figure; returns the SVG's path.
+pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
+    let saved = read_orders(&chart.orders)?;
+    let stale = |what: String| Error::input(chart.orders.display(), format!("{what}; rerun the experiment"));
+    let data = source::data_dir(chart.data.as_deref());
+    let mut models: Vec<(&str, Mesh)> = Vec::new();
+    for row in &saved {
+        if !models.iter().any(|(m, _)| *m == row.model) {
+            models.push((&row.model, Source::parse(&row.model)?.mesh(data.as_deref(), chart.seed)?));
+        }
+    }
+    let kind = chart.figure.kind;
     let mut drawings = Vec::new();
-    for (model, mesh) in work.models.iter().zip(&meshes) {
-        let label = if work.models.len() > 1 { format!("{}: ", short(model)) } else { String::new() };
-        let topology = (spec.figure.kind == FigureKind::Sequence).then(|| Topology::new(mesh));
-        for method in &spec.methods {
-            let Saved { order, starts } = orders
-                .get(&(model.clone(), method.clone()))
-                .ok_or_else(|| stale(format!("has no order for `{method}` on `{model}`")))?;
-            order::check_permutation(order, mesh.triangle_count())
-                .map_err(|why| stale(format!("`{method}` on `{model}` is not an order of this model ({why})")))?;
-            let triangles = mesh.triangles_in_order(order);
-            let acmr = |cache: &CacheModel| {
-                table.value("acmr", &[("model", model), ("method", method), ("cache", &cache.to_string())])
-            };
-            let name = method.split(':').next().unwrap_or(method);
-            let checked_acmr = |cache: &CacheModel| -> Result<(f64, Vec<[Corner; 3]>)> {
-                let (stats, classes) = cache::corners(*cache, &triangles, mesh.vertex_count());
-                let recorded = acmr(cache)?;
-                if (stats.acmr() - recorded).abs() > 1e-9 * recorded.max(1.0) {
-                    return Err(stale(format!(
-                        "`{method}` on `{model}` gives ACMR {} at {cache}, the results say {recorded}",
-                        stats.acmr()
-                    )));
-                }
-                Ok((recorded, classes))
-            };
-            match spec.figure.kind {
-                FigureKind::Sequence => {
-                    let topology = topology.as_ref().expect("built for sequences");
-                    let mut numbers = Vec::new();
-                    for cache in &work.caches {
-                        numbers.push(format!("{} {}", cache, axes::number(checked_acmr(cache)?.0)));
+    for row in &saved {
+        let (model, method) = (row.model.as_str(), row.method.as_str());
+        let mesh = &models.iter().find(|(m, _)| *m == model).expect("every model is loaded").1;
+        let label = if models.len() > 1 { format!("{}: ", short(model)) } else { String::new() };
+        let order: Vec<u32> = words(&row.order).map_err(|e| stale(format!("`{method}` on `{model}`: {e}")))?;
+        let starts: Vec<usize> = words(&row.clusters).map_err(|e| stale(format!("`{method}` on `{model}`: {e}")))?;
+        order::check_permutation(&order, mesh.triangle_count())
+            .map_err(|why| stale(format!("`{method}` on `{model}` is not an order of this model ({why})")))?;
+        if !order::tiles(&starts, order.len()) {
+            return Err(stale(format!("the clusters of `{method}` on `{model}` do not tile its order")));
+        }
+        let triangles = mesh.triangles_in_order(&order);
+        let acmrs = table.rows("acmr", &["model", "method", "cache"])?;
+        let recorded: Vec<(&str, f64)> =
+            acmrs.iter().filter(|(c, _)| c[0] == model && c[1] == method).map(|(c, v)| (c[2].as_str(), *v)).collect();
+        let name = method.split(':').next().unwrap_or(method);
+        match kind {
+            FigureKind::Sequence => {
+                let topology = Topology::new(mesh);
+                let numbers: Vec<String> = recorded.iter().map(|(c, v)| format!("{c} {}", axes::number(*v))).collect();
+                let adjacent =
+                    order.windows(2).map(|w| topology.neighbors.row(w[0] as usize).contains(&w[1])).collect();
+                drawings.push(Drawing {
+                    mesh,
+                    title: format!("{label}{name} · ACMR {}", numbers.join(", ")),
+                    triangles,
+                    kind: Content::Sequence { adjacent },
+                });
+            }
+            FigureKind::Corners => {
+                for entry in row.corners.split(';').filter(|e| !e.is_empty()) {
+                    let (cache, digits) = entry.split_once('=').ok_or_else(|| stale(format!("corners `{entry}`")))?;
+                    let classes =
+                        OrderRow::decode_corners(digits).map_err(|e| stale(format!("corners of {cache}: {e}")))?;
+                    let (_, acmr) = recorded.iter().find(|(c, _)| *c == cache).copied().ok_or_else(|| {
+                        stale(format!("the results have no ACMR of `{method}` on `{model}` at {cache}"))
+                    })?;
+                    let misses = classes.iter().flatten().filter(|c| **c != Corner::Hit).count();
+                    let drawn = misses as f64 / classes.len().max(1) as f64;
+                    if classes.len() != triangles.len() || (drawn - acmr).abs() > 1e-9 * acmr.max(1.0) {
+                        return Err(stale(format!(
+                            "the corners of `{method}` on `{model}` at {cache} give ACMR {drawn}, the results say {acmr}"
+                        )));
                     }
-                    let adjacent =
-                        order.windows(2).map(|w| topology.neighbors.row(w[0] as usize).contains(&w[1])).collect();
+                    if !first_loads_fit(&triangles, &classes, mesh.vertex_count()) {
+                        return Err(stale(format!(
+                            "the corners of `{method}` on `{model}` at {cache} do not fit its order"
+                        )));
+                    }
                     drawings.push(Drawing {
                         mesh,
-                        title: format!("{label}{name} · ACMR {}", numbers.join(", ")),
-                        triangles,
-                        kind: Content::Sequence { adjacent },
-                    });
-                }
-                FigureKind::Corners => {
-                    for cache in &work.caches {
-                        let (recorded, classes) = checked_acmr(cache)?;
-                        drawings.push(Drawing {
-                            mesh,
-                            title: format!("{label}{name} · {cache} · ACMR {}", axes::number(recorded)),
-                            triangles: triangles.clone(),
-                            kind: Content::Corners(classes),
-                        });
-                    }
-                }
-                kind => {
-                    let cache = work.caches.first().ok_or_else(|| stale("has no cache model".into()))?;
-                    let (recorded, _) = checked_acmr(cache)?;
-                    let clusters = format!("{} clusters · ", starts.len() - 1);
-                    let (content, clusters) = match kind {
-                        FigureKind::Clusters => (Content::Clusters(cluster_colours(starts, false)), clusters),
-                        FigureKind::ClusterOrder => (Content::Clusters(cluster_colours(starts, true)), clusters),
-                        _ => (Content::Overdraw, String::new()),
-                    };
-                    drawings.push(Drawing {
-                        mesh,
-                        title: format!("{label}{name} · {clusters}{cache} ACMR {}", axes::number(recorded)),
-                        triangles,
-                        kind: content,
+                        title: format!("{label}{name} · {cache} · ACMR {}", axes::number(acmr)),
+                        triangles: triangles.clone(),
+                        kind: Content::Corners(classes),
                     });
                 }
             }
+            kind => {
+                let (cache, acmr) = *recorded.first().ok_or_else(|| stale("has no cache model".into()))?;
+                let clusters = format!("{} clusters · ", starts.len() - 1);
+                let (content, clusters) = match kind {
+                    FigureKind::Clusters => (Content::Clusters(cluster_colours(&starts, false)), clusters),
+                    FigureKind::ClusterOrder => (Content::Clusters(cluster_colours(&starts, true)), clusters),
+                    _ => {
+                        let bytes = base64::engine::general_purpose::STANDARD
+                            .decode(&row.overdraw)
+                            .map_err(|e| stale(format!("the overdraw picture of `{method}` on `{model}`: {e}")))?;
+                        let (res, shaded) = OrderRow::decode_counts(&bytes)
+                            .map_err(|e| stale(format!("the overdraw picture of `{method}` on `{model}`: {e}")))?;
+                        if res != views::DRAWING_RES {
+                            return Err(stale(format!(
+                                "the overdraw picture of `{method}` on `{model}` is {res}² pixels"
+                            )));
+                        }
+                        (Content::Overdraw(shaded), String::new())
+                    }
+                };
+                drawings.push(Drawing {
+                    mesh,
+                    title: format!("{label}{name} · {clusters}{cache} ACMR {}", axes::number(acmr)),
+                    triangles,
+                    kind: content,
+                });
+            }
         }
     }
-    let path = spec.svg_path(&opts.out_dir, opts.quick);
-    let svg = render(spec, opts.quick, &drawings).map_err(|e| Error::output(&path, format!("cannot draw: {e}")))?;
+    let path = chart.svg.clone();
+    let svg = render(chart, &drawings).map_err(|e| Error::output(&path, format!("cannot draw: {e}")))?;
     save(&path, &svg)?;
     Ok(path)
+}
+
+/// Whether `classes` can be the corners of `triangles` drawn in order: every vertex's first use is
+/// its one first load, and no later use is. Catches an order and corners saved by different runs
+/// without replaying the cache.
+fn first_loads_fit(triangles: &[[u32; 3]], classes: &[[Corner; 3]], vertex_count: usize) -> bool {
+    let mut seen = vec![false; vertex_count];
+    triangles.iter().zip(classes).all(|(t, c)| {
+        (0..3).all(|k| {
+            let first = !std::mem::replace(&mut seen[t[k] as usize], true);
+            first == (c[k] == Corner::Miss(1))
+        })
+    })
 }
 
 /// `models/horse.ply@40000` → `horse.ply@40000`.
@@ -181,44 +211,36 @@ fn short(model: &str) -> &str {
     model.rsplit('/').next().unwrap_or(model)
 }
 
-/// An order as saved: triangle ids in draw order and where its clusters start.
-struct Saved {
-    order: Vec<u32>,
-    starts: Vec<usize>,
+/// Whitespace-separated numbers.
+fn words<T: std::str::FromStr>(text: &str) -> std::result::Result<Vec<T>, String>
+where
+    T::Err: std::fmt::Display,
+{
+    text.split_whitespace().map(|w| w.parse::<T>().map_err(|e| format!("`{w}`: {e}"))).collect()
 }
 
-/// The orders file, by (model, method), each in position order.
-fn read_orders(path: &Path) -> Result<HashMap<(String, String), Saved>> {
+/// The orders file's rows, in the order the run wrote them; a second row for the same model and
+/// method is an error.
+fn read_orders(path: &Path) -> Result<Vec<OrderRow>> {
     let mut reader = csv::Reader::from_path(path).map_err(|e| {
         Error::input(
             path.display(),
             format!("cannot read the orders ({e}); run the experiment first (`triorder run SPEC`)"),
         )
     })?;
-    let mut orders: HashMap<(String, String), Saved> = HashMap::new();
+    let mut rows: Vec<OrderRow> = Vec::new();
     for (i, row) in reader.deserialize::<OrderRow>().enumerate() {
         let line = i + 2;
         let row = row.map_err(|e| Error::input(path.display(), format!("line {line}: {e}")))?;
-        let words = |text: &str, what: &str| {
-            text.split_whitespace().map(str::parse).collect::<std::result::Result<Vec<_>, _>>().map_err(
-                |e: std::num::ParseIntError| {
-                    Error::input(path.display(), format!("line {line}: {what} that is not one: {e}"))
-                },
-            )
-        };
-        let order: Vec<u32> = words(&row.order, "a triangle id")?;
-        let starts: Vec<usize> = words(&row.clusters, "a cluster start")?.into_iter().map(|s| s as usize).collect();
-        if !order::tiles(&starts, order.len()) {
-            return Err(Error::input(path.display(), format!("line {line}: the cluster starts do not tile the order")));
-        }
-        if orders.insert((row.model, row.method), Saved { order, starts }).is_some() {
+        if rows.iter().any(|r| r.model == row.model && r.method == row.method) {
             return Err(Error::input(
                 path.display(),
                 format!("line {line}: a second order for the same model and method"),
             ));
         }
+        rows.push(row);
     }
-    Ok(orders)
+    Ok(rows)
 }
 
 /// Where a drawing's mesh lands: the orthographic projection of the spec's view, its bounding
@@ -233,7 +255,7 @@ struct Placement {
 
 impl Placement {
     fn new(mesh: &Mesh, view: [f32; 3]) -> Placement {
-        let camera = views::orthographic(Framing::of(&mesh.positions), Vec3::from(view).normalize());
+        let camera = views::drawing_camera(&mesh.positions, view);
         let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
         for &p in &mesh.positions {
             let q = ndc(&camera, p);
@@ -258,8 +280,8 @@ fn ndc(camera: &views::Camera, p: Vec3) -> Vec2 {
 }
 
 /// The whole SVG: header, panels in a grid, a legend line.
-fn render(spec: &Spec, quick: bool, drawings: &[Drawing]) -> std::result::Result<String, String> {
-    let placements: Vec<Placement> = drawings.iter().map(|d| Placement::new(d.mesh, spec.figure.view)).collect();
+fn render(chart: &Chart, drawings: &[Drawing]) -> std::result::Result<String, String> {
+    let placements: Vec<Placement> = drawings.iter().map(|d| Placement::new(d.mesh, chart.figure.view)).collect();
     let cols = match drawings.len() {
         1 => 1,
         2 | 4 => 2,
@@ -268,8 +290,8 @@ fn render(spec: &Spec, quick: bool, drawings: &[Drawing]) -> std::result::Result
     let row_h: Vec<u32> =
         placements.chunks(cols).map(|row| TITLE_H + MARGIN + row.iter().map(|p| p.height).max().unwrap_or(0)).collect();
     let width = cols as u32 * PANEL_W;
-    let setup = if quick { "quick run: small stand-in models, not the paper's" } else { "" };
-    let header = Header::new(spec, setup, width);
+    let setup = if chart.quick { "quick run: small stand-in models, not the paper's" } else { "" };
+    let header = Header::new(chart, setup, width);
     let height = header.height + row_h.iter().sum::<u32>() + LEGEND_H;
 
     // Panel origins (top left of the title) in a grid, row heights fitting their tallest mesh.
@@ -353,24 +375,12 @@ fn sequence(
 /// triangle (corners) or cluster (clusters) borders. Overdraw: the grey of the number of fragments
 /// shaded at the pixel in draw order, lightly shaded so the shape reads.
 fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std::result::Result<String, String> {
-    // The rasterizer draws the NDC square [-1, 1]²; choose its size so the mesh's box gets
-    // OVERSAMPLE pixels per SVG pixel, then crop to that box.
-    let span = (place.hi - place.lo).max(Vec2::splat(1e-6));
-    let res = ((OVERSAMPLE * place.width as f32 * 2.0 / span.x).ceil() as u32).clamp(16, cpu::MAX_RESOLUTION);
+    // The rasterizer draws the NDC square [-1, 1]² at the resolution the run saved its pictures
+    // at; the image is cropped to the mesh's box.
+    let res = views::DRAWING_RES;
     let positions = &drawing.mesh.positions;
     let ids = cpu::visible_triangles(positions, &drawing.triangles, &place.camera, res).map_err(|e| e.to_string())?;
     let n = res as usize;
-    let shaded = match drawing.kind {
-        Content::Overdraw => {
-            let mut fragments = Vec::new();
-            cpu::fragments(positions, &drawing.triangles, &place.camera, res, &mut fragments)
-                .map_err(|e| e.to_string())?;
-            let mut shaded = vec![0u32; n * n];
-            fragments.iter().filter(|f| f.passed).for_each(|f| shaded[f.pixel as usize] += 1);
-            shaded
-        }
-        _ => Vec::new(),
-    };
     let to_px = |v: f32| ((v + 1.0) * 0.5 * res as f32).clamp(0.0, res as f32);
     let (x0, x1) = (to_px(place.lo.x).floor() as usize, to_px(place.hi.x).ceil() as usize);
     let (y0, y1) = (to_px(place.lo.y).floor() as usize, to_px(place.hi.y).ceil() as usize);
@@ -412,7 +422,7 @@ fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std
                     let here = cluster(t);
                     (colours[t as usize].0, cluster(id(x + 1, y)) != here || cluster(id(x, y + 1)) != here)
                 }
-                Content::Overdraw => {
+                Content::Overdraw(shaded) => {
                     let k = (shaded[y * n + x] as usize).clamp(1, OVERDRAW_GREYS.len());
                     ([OVERDRAW_GREYS[k - 1]; 3], false)
                 }
@@ -421,7 +431,7 @@ fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std
             let [pa, pb, pc] = tri.map(|v| positions[v as usize]);
             let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
             // Overdraw greys carry the data, so their facets are shaded only lightly.
-            let relief = if matches!(drawing.kind, Content::Overdraw) { 0.15 } else { 0.5 };
+            let relief = if matches!(drawing.kind, Content::Overdraw(_)) { 0.15 } else { 0.5 };
             let mut shade = 1.0 - relief + relief * normal.dot(-place.camera.forward).abs();
             if border {
                 shade *= 0.6;
@@ -473,7 +483,7 @@ fn legend(root: &super::axes::Area, kind: &Content, y: i32) -> DrawResult {
             &[([0, 0, 0], "first cluster drawn"), ([128, 128, 128], "…"), ([255, 255, 255], "last cluster drawn")],
         ),
         Content::Clusters(_) => root.draw_text("colour: cluster (facets shaded by angle to the view)", &style, (12, y)),
-        Content::Overdraw => {
+        Content::Overdraw(_) => {
             let labels = ["1 fragment shaded", "2", "3", "4", "5 or more"];
             let entries: Vec<([u8; 3], &str)> = OVERDRAW_GREYS.iter().map(|&g| [g, g, g]).zip(labels).collect();
             swatches(root, y, &entries)

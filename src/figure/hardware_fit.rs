@@ -19,10 +19,9 @@ use plotters::prelude::*;
 
 use super::axes::{self, Area, Colors, DrawResult, FONT, Frame, Painter};
 use super::data::Table;
-use super::{Header, PlotOptions, save};
+use super::{Chart, Header, save};
 use crate::error::{Error, Result};
-use crate::eval::GPU_CACHE;
-use crate::experiment::spec::Spec;
+use crate::measure::GPU_CACHE;
 
 /// How well one simulated model predicts the counted ACMR.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,7 +100,7 @@ fn least_squares(points: &[(f64, f64)]) -> (f64, f64) {
 const TABLE_ROWS: usize = 14;
 
 /// Draws the figure; returns the SVG's path.
-pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
+pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
     let fits = fits(table)?;
     let best = &fits[0];
     let device = table.distinct(&["cache", "backend"]).into_iter().find(|r| r[0] == GPU_CACHE).map(|r| r[1].clone());
@@ -111,11 +110,11 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
         best.points.len(),
         fits.len()
     );
-    let path = spec.svg_path(&opts.out_dir, opts.quick);
+    let path = chart.svg.clone();
     // The ranking, then a line per mesh under it; the scatter beside them needs 620 pixels.
     let lines = 34 + 22 * (TABLE_ROWS as u32 + 1) + 34 + 20 * best.best.len() as u32 + 30;
     let (width, body) = (1300u32, lines.max(620));
-    let header = Header::new(spec, &setup, width);
+    let header = Header::new(chart, &setup, width);
     let mut names: Vec<String> = Vec::new();
     for (_, _, name) in &best.points {
         if !names.contains(name) {

@@ -14,6 +14,7 @@ mod distribution;
 mod drawing;
 mod hardware_fit;
 mod ratio;
+pub mod spec;
 mod table;
 mod xy;
 
@@ -24,20 +25,19 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::error::{Error, Result};
-use crate::experiment::row::METRICS;
-use crate::experiment::spec::{Figure, FigureKind, Spec};
+use crate::measure;
 use axes::{Area, Colors, DrawResult, FONT, Frame, Swatch};
 use data::{Panel, Table};
+use spec::{Figure, FigureKind};
 
-/// Where to read results and write the figure.
+/// Where a figure's results are read and the figure written.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PlotOptions {
     /// Plot the quick run (`results/quick/` → `paper-figures/quick/`).
     pub quick: bool,
     /// The project root holding `results/` and `paper-figures/`.
     pub out_dir: PathBuf,
-    /// Where drawing figures (kinds `sequence`, `corners`) find the models' geometry: as for runs,
-    /// else `TRIORDER_DATA`, else `../shared/data`.
+    /// Where drawings find the models' geometry (else `TRIORDER_DATA`, else `../shared/data`).
     pub data: Option<PathBuf>,
 }
 
@@ -47,31 +47,47 @@ impl Default for PlotOptions {
     }
 }
 
-/// Draws the figure of the spec at `spec` from its CSV; returns the SVG's path.
-pub fn plot(spec: &Path, opts: &PlotOptions) -> Result<PathBuf> {
-    plot_spec(&Spec::load(spec)?, opts)
+/// What one figure is drawn from and where it goes: its spec's `[figure]` table and header, its
+/// results, and where drawings find the models' geometry.
+pub struct Chart<'a> {
+    pub figure: &'a Figure,
+    /// The spec file, for errors about the figure.
+    pub spec: &'a Path,
+    pub title: &'a str,
+    pub claim: Option<&'a str>,
+    /// The results CSV and, for drawings, the orders file beside it.
+    pub csv: PathBuf,
+    pub orders: PathBuf,
+    pub svg: PathBuf,
+    /// A quick run's figure (stand-in models): its header says so.
+    pub quick: bool,
+    /// Where drawings find the models' geometry: as for runs, else `TRIORDER_DATA`, else
+    /// `../shared/data`.
+    pub data: Option<PathBuf>,
+    /// Seeds the seeded procedural models (`disk:N`) drawings rebuild.
+    pub seed: u64,
 }
 
-/// Draws the figure of a loaded spec (see [`plot`]).
-pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
-    let csv = spec.csv_path(&opts.out_dir, opts.quick);
-    let table = Table::read(&csv)?;
+/// Draws `chart` from its CSV; returns the SVG's path.
+pub fn plot(chart: &Chart) -> Result<PathBuf> {
+    let csv = &chart.csv;
+    let table = Table::read(csv)?;
     // Panels of series, for the chart kinds; the other kinds lay out their own figure.
     let panels;
-    let figure = &spec.figure;
+    let figure = chart.figure;
     let mut setup: Vec<String> = table
         .distinct(&["views", "res"])
         .iter()
         .map(|v| format!("views {} at {}×{} pixels", v[0], v[1], v[1]))
         .collect();
-    if opts.quick {
+    if chart.quick {
         setup.push("quick run: small stand-in models, not the paper's".into());
     }
     let kind: Box<dyn Kind> = match figure.kind {
         FigureKind::Line | FigureKind::Scatter => {
             panels = table.select(figure)?;
             let x = figure.x.as_deref().unwrap_or_default();
-            Box::new(xy::Xy::new(&panels, x, figure.kind == FigureKind::Line, &csv)?)
+            Box::new(xy::Xy::new(&panels, x, figure.kind == FigureKind::Line, csv)?)
         }
         FigureKind::Bar => {
             panels = table.select(figure)?;
@@ -89,17 +105,17 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
         | FigureKind::Corners
         | FigureKind::Clusters
         | FigureKind::ClusterOrder
-        | FigureKind::Overdraw => return drawing::plot(spec, opts, &table),
-        FigureKind::HardwareFit => return hardware_fit::plot(spec, opts, &table),
-        FigureKind::Ratio => return ratio::plot(spec, opts, &table),
+        | FigureKind::Overdraw => return drawing::plot(chart, &table),
+        FigureKind::HardwareFit => return hardware_fit::plot(chart, &table),
+        FigureKind::Ratio => return ratio::plot(chart, &table),
     };
     // Panels share their axes, except panels of different metrics, whose units differ.
     let frames = if figure.facet.as_deref() == Some("metric") {
         (0..panels.len())
-            .map(|i| frame(kind.as_ref(), figure, &csv, Some((i, &panels[i].title))))
+            .map(|i| frame(kind.as_ref(), figure, csv, Some((i, &panels[i].title))))
             .collect::<Result<Vec<_>>>()?
     } else {
-        vec![frame(kind.as_ref(), figure, &csv, None)?]
+        vec![frame(kind.as_ref(), figure, csv, None)?]
     };
     let mut names: Vec<String> = Vec::new();
     for s in panels.iter().flat_map(|p| &p.series) {
@@ -109,9 +125,9 @@ pub fn plot_spec(spec: &Spec, opts: &PlotOptions) -> Result<PathBuf> {
     }
     let colors = Colors::new(&figure.series, &names);
 
-    let path = spec.svg_path(&opts.out_dir, opts.quick);
+    let path = chart.svg.clone();
     let mut svg = String::new();
-    draw(&mut svg, spec, &setup.join(" · "), &panels, kind.as_ref(), &frames, &colors)
+    draw(&mut svg, chart, &setup.join(" · "), &panels, kind.as_ref(), &frames, &colors)
         .map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
     save(&path, &svg)?;
     Ok(path)
@@ -196,7 +212,7 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &st
         }
         None => pad(lo, hi, figure.y_log),
     };
-    let label = |name: &str| METRICS.iter().find(|m| m.name == name).map_or(name.to_string(), |m| m.label.to_string());
+    let label = |name: &str| measure::label(name).to_string();
     let metric = if figure.metrics.len() == 1 { label(&figure.metric) } else { figure.metrics.join(" / ") };
     let x_desc = match (&figure.x_label, &figure.x) {
         (Some(label), _) => label.clone(),
@@ -248,7 +264,7 @@ const MAX_SIDE_BY_SIDE_W: usize = 1000;
 /// Draws the whole figure into `svg`; `setup` (how the data was measured) goes under the title.
 fn draw(
     svg: &mut String,
-    spec: &Spec,
+    chart: &Chart,
     setup: &str,
     panels: &[Panel],
     kind: &dyn Kind,
@@ -267,7 +283,7 @@ fn draw(
     let rows = n.div_ceil(cols);
     let (panel_w, panel_h) = kind.panel_size().unwrap_or(if n == 1 { (760, 500) } else { (540, 400) });
     let width = (cols * panel_w) as u32;
-    let header = Header::new(spec, setup, width);
+    let header = Header::new(chart, setup, width);
     let legend_h = if kind.legend() { axes::legend_height(colors.entries(), width) } else { 0 };
     let height = header.height + (rows * panel_h) as u32 + legend_h;
 
@@ -297,11 +313,11 @@ struct Header {
 }
 
 impl Header {
-    fn new(spec: &Spec, setup: &str, width: u32) -> Header {
+    fn new(chart: &Chart, setup: &str, width: u32) -> Header {
         let chars = |size: f64| (f64::from(width - 40) / (size * 0.55)) as usize;
-        let title = axes::wrap(&spec.title, chars(20.0));
+        let title = axes::wrap(chart.title, chars(20.0));
         let setup = axes::wrap(setup, chars(13.0));
-        let claim = spec.claim.as_deref().map_or_else(Vec::new, |c| axes::wrap(&format!("Paper: {c}"), chars(13.0)));
+        let claim = chart.claim.map_or_else(Vec::new, |c| axes::wrap(&format!("Paper: {c}"), chars(13.0)));
         let height = 16 + 28 * title.len() as u32 + 18 * (setup.len() + claim.len()) as u32 + 10;
         Header { width, title, setup, claim, height }
     }

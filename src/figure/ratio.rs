@@ -10,19 +10,18 @@ use plotters::prelude::*;
 
 use super::axes::{self, Area, Colors, DrawResult, Frame, Painter};
 use super::data::Table;
-use super::{Header, PlotOptions, save};
+use super::{Chart, Header, save};
 use crate::error::{Error, Result};
-use crate::experiment::spec::Spec;
 
 /// Per series: (x ratio, y ratio) per view.
 type Points = Vec<(String, Vec<(f64, f64)>)>;
 
 /// The points: for each series value and view, A ÷ B of the x metric and of the y metric.
-fn points(spec: &Spec, table: &Table) -> Result<Points> {
-    let figure = &spec.figure;
+fn points(chart: &Chart, table: &Table) -> Result<Points> {
+    let figure = chart.figure;
     let stale = |why: String| Error::input(table.path().display(), format!("{why}; rerun the experiment"));
     let (Some((a, b)), Some(x)) = (&figure.ratio, figure.x.as_deref().and_then(|x| x.strip_prefix("metric:"))) else {
-        return Err(Error::spec(&spec.path, "kind = \"ratio\" needs figure.ratio and x = \"metric:NAME\""));
+        return Err(Error::spec(chart.spec, "kind = \"ratio\" needs figure.ratio and x = \"metric:NAME\""));
     };
     // (metric, series, model, view, method name) → value.
     let mut values: HashMap<(bool, String, String, String, String), f64> = HashMap::new();
@@ -72,9 +71,9 @@ pub fn pearson(points: &[(f64, f64)]) -> f64 {
 }
 
 /// Draws the figure; returns the SVG's path.
-pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
-    let figure = &spec.figure;
-    let points = points(spec, table)?;
+pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
+    let figure = chart.figure;
+    let points = points(chart, table)?;
     let (a, b) = figure.ratio.clone().unwrap_or_default();
     let x_metric = figure.x.as_deref().and_then(|x| x.strip_prefix("metric:")).unwrap_or_default();
     let devices: Vec<String> =
@@ -88,7 +87,7 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
             .join(" · ")
     );
     setup += &format!(" · measured on {}", devices.join(", "));
-    if opts.quick {
+    if chart.quick {
         setup += " · quick run: small stand-in models, not the paper's";
     }
     let all = points.iter().flat_map(|(_, p)| p);
@@ -107,9 +106,9 @@ pub fn plot(spec: &Spec, opts: &PlotOptions, table: &Table) -> Result<PathBuf> {
     let names: Vec<String> = points.iter().map(|(s, _)| s.clone()).collect();
     let colors = Colors::new(&figure.series, &names);
     let width = 760;
-    let header = Header::new(spec, &setup, width);
+    let header = Header::new(chart, &setup, width);
     let legend_h = axes::legend_height(colors.entries(), width);
-    let path = spec.svg_path(&opts.out_dir, opts.quick);
+    let path = chart.svg.clone();
     let mut svg = String::new();
     let drawn = (|| -> DrawResult {
         let root = SVGBackend::with_string(&mut svg, (width, header.height + 560 + legend_h)).into_drawing_area();

@@ -1,5 +1,5 @@
 //! The GPU, through wgpu (Vulkan): one device per process, opened on first use, shared by the
-//! raster backend ([`crate::raster::gpu`]) and the hardware measurements (vertex-shader invocations,
+//! raster backend ([`crate::gpu::raster`]) and the hardware measurements (vertex-shader invocations,
 //! render time). On a software adapter the raster backend also draws on a [`pool`] of devices.
 //!
 //! Every failure a user can meet here becomes an [`Error::Gpu`] that says what to do: no Vulkan
@@ -7,6 +7,7 @@
 //! validation or out-of-memory error, a submission that does not finish within [`WAIT`].
 //! Nothing here panics on a driver's answer.
 
+pub mod raster;
 pub mod render_time;
 pub mod vertex_reuse;
 

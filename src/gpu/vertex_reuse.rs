@@ -2,7 +2,7 @@
 //! pipeline-statistics query (issue 6; Kerbl et al. 2018 measure GPUs the same way).
 //!
 //! Invocations ÷ triangles is a hardware ACMR and invocations ÷ referenced vertices a hardware
-//! ATVR, directly comparable with the simulated cache models of [`crate::metrics::cache`]. A
+//! ATVR, directly comparable with the simulated cache models of [`crate::measure::cache`]. A
 //! device reports what its vertex front end really shaded: on an NVIDIA H100 that is its batch
 //! reuse; on Mesa's lavapipe it is reuse within the draw module's small batches only
 //! (../shared/GPU.md), so lavapipe checks the plumbing, not the hardware.
@@ -14,7 +14,6 @@ use glam::Vec3;
 
 use super::Gpu;
 use crate::error::{Error, Result};
-use crate::metrics::CacheStats;
 
 const SHADER: &str = r#"
 @vertex
@@ -101,16 +100,11 @@ impl VertexCounter {
     }
 
     /// Vertex-shader invocations when `triangles` are drawn in order, once, as one indexed
-    /// triangle list over `positions`: the GPU's misses, as [`CacheStats`].
-    pub fn count(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<CacheStats> {
-        let mut seen = vec![false; positions.len()];
-        for &v in triangles.iter().flatten() {
-            let slot = seen.get_mut(v as usize).ok_or_else(|| {
-                Error::usage(format!("vertex index {v} is out of range for {} vertices", positions.len()))
-            })?;
-            *slot = true;
+    /// triangle list over `positions`: the GPU's cache misses.
+    pub fn count(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<u64> {
+        if let Some(&v) = triangles.iter().flatten().find(|&&v| v as usize >= positions.len()) {
+            return Err(Error::usage(format!("vertex index {v} is out of range for {} vertices", positions.len())));
         }
-        let referenced = seen.iter().filter(|&&s| s).count();
         let invocations = self.gpu.checked("counting vertex-shader invocations", || {
             let device = &self.gpu.device;
             let (vertices, index, index_count) = self.gpu.mesh_buffers(bytemuck::cast_slice(positions), triangles)?;
@@ -153,6 +147,6 @@ impl VertexCounter {
             let bytes = self.gpu.read_back(encoder, &[&resolved])?;
             Ok(bytemuck::pod_read_unaligned::<u64>(&bytes[0][..8]))
         })?;
-        Ok(CacheStats { triangles: triangles.len(), vertices: referenced, misses: invocations, batches: 0 })
+        Ok(invocations)
     }
 }

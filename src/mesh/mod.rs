@@ -7,20 +7,27 @@
 //! coordinates, indices in range, at least one triangle) so no later stage has to.
 
 pub mod animated;
+pub mod frames;
 pub mod gltf;
-pub mod gltf_animation;
-pub mod keyframes;
+
 pub mod load;
 pub mod obj;
 pub mod ply;
 pub mod procedural;
 pub mod report;
 pub mod save;
+pub mod scene;
 pub mod simplify;
 pub mod source;
 pub mod subdivide;
+pub mod topology;
 
 use glam::Vec3;
+
+pub use frames::{Frames, Framing};
+pub use scene::Scene;
+pub use source::Source;
+pub use topology::Topology;
 
 use crate::error::{Error, Result};
 
@@ -104,6 +111,18 @@ impl Mesh {
         self.positions
             .iter()
             .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    }
+
+    /// The triangles as a flat index buffer, as libraries and GPUs take them.
+    pub fn index_buffer(&self) -> Vec<u32> {
+        self.triangles.iter().flatten().copied().collect()
+    }
+
+    /// The positions as meshoptimizer reads them: tightly packed `[f32; 3]`.
+    pub fn meshopt_positions(&self) -> meshopt::VertexDataAdapter<'_> {
+        let bytes = meshopt::typed_to_bytes(&self.positions);
+        meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<Vec3>(), 0)
+            .expect("Vec3 slices are a whole number of 12-byte vertices")
     }
 
     /// The triangles in the order `order` (new position → old triangle id). The caller guarantees

@@ -8,7 +8,7 @@ use std::collections::HashSet;
 use std::fmt;
 
 use crate::mesh::Mesh;
-use crate::topology::Topology;
+use crate::mesh::topology::Topology;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct MeshReport {

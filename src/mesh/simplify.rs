@@ -8,7 +8,6 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::peer;
 
 /// How far from the requested count a result may land: the simplifier collapses edges in
 /// batches, so it may pass the target by a few triangles, and stops short when no collapse is left.
@@ -40,10 +39,10 @@ pub fn simplify(mesh: &Mesh, target: usize) -> Result<Mesh> {
             format!("asks for {target} triangles but the model has only {}", mesh.triangle_count()),
         ));
     }
-    let indices = peer::index_buffer(mesh);
+    let indices = mesh.index_buffer();
     // Error limit 1.0 (the whole model's extent): the triangle count alone decides where to stop.
     let simplified =
-        meshopt::simplify(&indices, &peer::positions(mesh), 3 * target, 1.0, meshopt::SimplifyOptions::None, None);
+        meshopt::simplify(&indices, &mesh.meshopt_positions(), 3 * target, 1.0, meshopt::SimplifyOptions::None, None);
     let reached = simplified.len() / 3;
     if (reached as f64 - target as f64).abs() > target as f64 * TOLERANCE {
         return Err(Error::input(

@@ -69,7 +69,7 @@ use super::animated::Animated;
 use super::procedural::MAX_TRIANGLES;
 use super::{Mesh, VertexAttributes};
 use crate::error::{Error, Result};
-use crate::topology::Topology;
+use crate::mesh::topology::Topology;
 
 const NONE: u32 = u32::MAX;
 

@@ -51,9 +51,24 @@
 //! and fall back to input order only when no vertex that has been touched has triangles left (a
 //! fresh component).
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
-use crate::topology::Csr;
+use crate::mesh::Scene;
+use crate::mesh::topology::Csr;
+
+const CACHE: ParamInfo = ParamInfo {
+    name: "cache",
+    default: "32",
+    kind: ParamKind::Int { min: 4, max: 1024 },
+    help: "LRU size the scores model (Forsyth: 32)",
+};
+
+const SCORES: ParamInfo = ParamInfo {
+    name: "scores",
+    default: "tuned",
+    kind: ParamKind::Choice(&["tuned", "forsyth"]),
+    help: "score table: ours, tuned against meshoptimizer at cache=32, or the article's",
+};
 
 pub static METHOD: Method = Method {
     name: "forsyth",
@@ -61,29 +76,16 @@ pub static METHOD: Method = Method {
     source: "Forsyth 2006, Linear-Speed Vertex Cache Optimisation",
     peer: false,
     per_node: false,
-    params: &[
-        ParamInfo {
-            name: "cache",
-            default: "32",
-            kind: ParamKind::Int { min: 4, max: 1024 },
-            help: "LRU size the scores model (Forsyth: 32)",
-        },
-        ParamInfo {
-            name: "scores",
-            default: "tuned",
-            kind: ParamKind::Choice(&["tuned", "forsyth"]),
-            help: "score table: ours, tuned against meshoptimizer at cache=32, or the article's",
-        },
-    ],
+    params: &[CACHE, SCORES],
     build,
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    let scores = match params.word("scores") {
+    let scores = match params.word(&SCORES) {
         "forsyth" => Scores::Forsyth,
         _ => Scores::Tuned,
     };
-    Box::new(Forsyth { cache: params.int("cache") as usize, scores })
+    Box::new(Forsyth { cache: params.int(&CACHE) as usize, scores })
 }
 
 struct Forsyth {
@@ -92,8 +94,8 @@ struct Forsyth {
 }
 
 impl Ordering for Forsyth {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        Ok(forsyth(&input.mesh.triangles, &input.topology.vertex_triangles, self.cache, self.scores))
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        Ok(Orders::from(forsyth(&scene.mesh.triangles, &scene.topology.vertex_triangles, self.cache, self.scores)))
     }
 }
 
@@ -186,7 +188,7 @@ impl Evicted {
 }
 
 /// Forsyth's greedy order of `triangles` for an LRU of `cache` entries scored by `scores`;
-/// `vertex_triangles` is their vertex→triangle adjacency (as [`crate::topology::vertex_triangles`]
+/// `vertex_triangles` is their vertex→triangle adjacency (as [`crate::mesh::topology::vertex_triangles`]
 /// builds it).
 pub(crate) fn forsyth(triangles: &[[u32; 3]], vertex_triangles: &Csr, cache: usize, scores: Scores) -> Order {
     let mut state = State::new(triangles, vertex_triangles, cache, scores);
@@ -386,7 +388,7 @@ impl<'a> State<'a> {
 mod tests {
     use super::*;
     use crate::mesh::procedural;
-    use crate::topology::vertex_triangles;
+    use crate::mesh::topology::vertex_triangles;
 
     /// Replays `order` with nothing incremental: before each triangle, every live triangle with a
     /// corner among the cache's entries (the three just pushed out included) is scored from

@@ -6,10 +6,17 @@
 
 use glam::Vec3;
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
+use crate::mesh::Scene;
 
 const COMPONENT: ParamKind = ParamKind::Float { min: -1e6, max: 1e6 };
+
+const X: ParamInfo = ParamInfo { name: "x", default: "0", kind: COMPONENT, help: "view direction (model → eye), x" };
+
+const Y: ParamInfo = ParamInfo { name: "y", default: "0", kind: COMPONENT, help: "view direction, y" };
+
+const Z: ParamInfo = ParamInfo { name: "z", default: "1", kind: COMPONENT, help: "view direction, z" };
 
 pub static METHOD: Method = Method {
     name: "front-to-back",
@@ -17,16 +24,12 @@ pub static METHOD: Method = Method {
     source: "Nehab, Barczak & Sander 2006, §1 and Fig. 1a (the depth-sorted reference)",
     peer: false,
     per_node: false,
-    params: &[
-        ParamInfo { name: "x", default: "0", kind: COMPONENT, help: "view direction (model → eye), x" },
-        ParamInfo { name: "y", default: "0", kind: COMPONENT, help: "view direction, y" },
-        ParamInfo { name: "z", default: "1", kind: COMPONENT, help: "view direction, z" },
-    ],
+    params: &[X, Y, Z],
     build,
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    let d = ["x", "y", "z"].map(|k| params.float(k) as f32);
+    let d = [&X, &Y, &Z].map(|p| params.float(p) as f32);
     Box::new(FrontToBack { direction: Vec3::from_array(d) })
 }
 
@@ -35,11 +38,11 @@ struct FrontToBack {
 }
 
 impl Ordering for FrontToBack {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
+    fn order(&self, scene: &Scene) -> Result<Orders> {
         let direction = self.direction.try_normalize().ok_or_else(|| {
             Error::usage("method `front-to-back`: the view direction x, y, z must not be zero".to_string())
         })?;
-        let mesh = input.mesh;
+        let mesh = &scene.mesh;
         let depth: Vec<f32> = mesh
             .triangles
             .iter()
@@ -47,6 +50,6 @@ impl Ordering for FrontToBack {
             .collect();
         let mut order: Order = (0..mesh.triangle_count() as u32).collect();
         order.sort_by(|&a, &b| depth[b as usize].total_cmp(&depth[a as usize]));
-        Ok(order)
+        Ok(Orders::from(order))
     }
 }

@@ -55,9 +55,10 @@
 
 use std::collections::VecDeque;
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
-use crate::topology::Csr;
+use crate::mesh::Scene;
+use crate::mesh::topology::{Csr, LiveLists, NONE, copies, edge_neighbors};
 
 pub static METHOD: Method = Method {
     name: "hoppe",
@@ -79,7 +80,7 @@ pub(super) const CACHE: ParamInfo = ParamInfo {
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    Box::new(Hoppe { cache: params.int("cache") as u32 })
+    Box::new(Hoppe { cache: params.int(&CACHE) as u32 })
 }
 
 struct Hoppe {
@@ -87,162 +88,19 @@ struct Hoppe {
 }
 
 impl Ordering for Hoppe {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        let mesh = input.mesh;
-        let across = edge_neighbors(&mesh.triangles, &input.topology.weld);
-        let copy_of = copies(&mesh.triangles, &input.topology.weld);
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        let mesh = &scene.mesh;
+        let across = edge_neighbors(&mesh.triangles, &scene.topology.weld);
+        let copy_of = copies(&mesh.triangles, &scene.topology.weld);
         let strips = Strips::new(
             &mesh.triangles,
             &across,
             &copy_of,
-            &input.topology.vertex_triangles,
+            &scene.topology.vertex_triangles,
             mesh.vertex_count(),
             self.cache,
         );
-        Ok(strips.run())
-    }
-}
-
-/// No face, corner or vertex.
-pub(super) const NONE: u32 = u32::MAX;
-
-/// The triangle across each edge, as a *corner*: slot `3·t + k` describes edge k of triangle t,
-/// from `tri[k]` to `tri[k+1]` (welded); it holds `3·g + e` where edge e of triangle g is the same
-/// welded edge run the other way, or [`NONE`]. Read it as "enter g across its edge e": the
-/// corner of g at `g[e]`, which is (welded) `tri[k+1]`.
-///
-/// Only edges used by exactly two different triangles with opposite orientation are linked
-/// (DirectXMesh's rule): a fin, a duplicated face or a flipped neighbour has no well-defined
-/// "next face around the vertex", so we treat such edges as boundaries.
-///
-/// Two kinds of triangles are left out of the adjacency altogether, so that they do not make the
-/// edges of real neighbours non-manifold: degenerate ones (two corners welded together: no area,
-/// no "around") and copies of an earlier triangle (see [`copies`]; scanned meshes carry them,
-/// dragon_vrip_res3 has 1,254, each of which would otherwise cut its original and three
-/// neighbours out of the strips).
-pub(super) fn edge_neighbors(triangles: &[[u32; 3]], weld: &[u32]) -> Vec<u32> {
-    let copy_of = copies(triangles, weld);
-    let mut half_edges: Vec<(u64, u32, bool)> = Vec::with_capacity(3 * triangles.len());
-    for (t, tri) in triangles.iter().enumerate() {
-        let w = tri.map(|v| weld[v as usize]);
-        if copy_of[t] != NONE || w[0] == w[1] || w[1] == w[2] || w[2] == w[0] {
-            continue;
-        }
-        for k in 0..3 {
-            let (a, b) = (w[k], w[(k + 1) % 3]);
-            let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-            half_edges.push((key, (3 * t + k) as u32, a < b));
-        }
-    }
-    half_edges.sort_unstable();
-    let mut across = vec![NONE; 3 * triangles.len()];
-    for group in half_edges.chunk_by(|x, y| x.0 == y.0) {
-        if let [x, y] = group
-            && x.2 != y.2
-            && x.1 / 3 != y.1 / 3
-        {
-            across[x.1 as usize] = y.1;
-            across[y.1 as usize] = x.1;
-        }
-    }
-    across
-}
-
-/// For each triangle, the first triangle with the same three welded corners (in either
-/// orientation), or [`NONE`] for a triangle that is not a copy. Degenerate triangles (two corners
-/// welded together) are never copies: they have no area and no adjacency (see
-/// [`edge_neighbors`]) anyway.
-pub(super) fn copies(triangles: &[[u32; 3]], weld: &[u32]) -> Vec<u32> {
-    let mut keyed: Vec<([u32; 3], u32)> = triangles
-        .iter()
-        .enumerate()
-        .filter_map(|(t, tri)| {
-            let mut w = tri.map(|v| weld[v as usize]);
-            w.sort_unstable();
-            (w[0] != w[1] && w[1] != w[2]).then_some((w, t as u32))
-        })
-        .collect();
-    keyed.sort_unstable();
-    let mut copy_of = vec![NONE; triangles.len()];
-    for group in keyed.chunk_by(|x, y| x.0 == y.0) {
-        for x in &group[1..] {
-            copy_of[x.1 as usize] = group[0].1;
-        }
-    }
-    copy_of
-}
-
-/// Each mesh vertex's triangles not yet emitted, compacted lazily: an emitted triangle is
-/// dropped (swap-remove) the first time a scan meets it, so over a whole run the removals cost
-/// O(F) and a scan costs what is still there. Keeps high-valence vertices ("hubs": a fan centre
-/// of 10⁵ triangles) from making every scan through them O(valence) again and again.
-pub(super) struct LiveLists {
-    offsets: Vec<u32>,
-    len: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl LiveLists {
-    pub(super) fn new(vertex_triangles: &Csr) -> LiveLists {
-        let offsets = vertex_triangles.offsets().to_vec();
-        let len = offsets.windows(2).map(|w| w[1] - w[0]).collect();
-        LiveLists { offsets, len, items: vertex_triangles.items().to_vec() }
-    }
-
-    /// Entries still listed for `v` (an upper bound on its remaining triangles).
-    pub(super) fn len(&self, v: u32) -> usize {
-        self.len[v as usize] as usize
-    }
-
-    /// Up to `limit` remaining triangles of `v` (`done` tells emitted ones, which are dropped).
-    pub(super) fn live(&mut self, v: u32, limit: usize, done: impl Fn(u32) -> bool) -> &[u32] {
-        let base = self.offsets[v as usize] as usize;
-        let mut len = self.len[v as usize] as usize;
-        let mut i = 0;
-        while i < len && i < limit {
-            if done(self.items[base + i]) {
-                len -= 1;
-                self.items[base + i] = self.items[base + len];
-            } else {
-                i += 1;
-            }
-        }
-        self.len[v as usize] = len as u32;
-        &self.items[base..base + i]
-    }
-
-    /// Into `out`, sorted: the remaining triangles using `w` whose vertices are all `cached`,
-    /// right after `w` was pushed into a FIFO holding `ring`. Scans either `w`'s list or those
-    /// of the other cached vertices (keeping the triangles that use `w`), whichever is shorter.
-    pub(super) fn completed_by(
-        &mut self,
-        w: u32,
-        ring: &[u32],
-        triangles: &[[u32; 3]],
-        done: impl Fn(u32) -> bool,
-        cached: impl Fn(u32) -> bool,
-        out: &mut Vec<u32>,
-    ) {
-        out.clear();
-        let others = ring.iter().filter(|&&u| u != NONE && u != w).map(|&u| self.len(u)).sum::<usize>();
-        if self.len(w) <= others {
-            for &t in self.live(w, usize::MAX, &done) {
-                if triangles[t as usize].iter().all(|&x| cached(x)) {
-                    out.push(t);
-                }
-            }
-        } else {
-            for &u in ring.iter().filter(|&&u| u != NONE && u != w) {
-                for &t in self.live(u, usize::MAX, &done) {
-                    let tri = triangles[t as usize];
-                    if tri.contains(&w) && tri.iter().all(|&x| cached(x)) {
-                        out.push(t);
-                    }
-                }
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
+        Ok(Orders::from(strips.run()))
     }
 }
 

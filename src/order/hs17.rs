@@ -38,14 +38,48 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
-use super::per_node::{Lookup, NodeOrders};
 use super::sander07::{LAMBDA, patches};
 use super::tipsify::FIFO_CACHE;
-use super::{Clustered, Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params, needs_nodes};
+use super::{Clustered, Lookup, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
-use crate::mesh::keyframes::Keyframes;
+use crate::mesh::{Frames, Scene};
 use crate::raster::cpu::{Fragment, fragments};
 use crate::raster::views::{Camera, icosphere_directions, perspective};
+
+const CLUSTERS: ParamInfo = ParamInfo {
+    name: "clusters",
+    default: "5",
+    kind: ParamKind::Int { min: 1, max: 64 },
+    help: "k, the number of index buffers (per clip with mode=single)",
+};
+
+const VIEWS: ParamInfo = ParamInfo {
+    name: "views",
+    default: "162",
+    kind: ParamKind::Choice(&["12", "42", "162", "642"]),
+    help: "icosahedron viewpoints optimized for (nodes = keyframes × views)",
+};
+
+const RES: ParamInfo = ParamInfo {
+    name: "res",
+    default: "128",
+    kind: ParamKind::Int { min: 16, max: 4096 },
+    help: "side of the square images nodes are rasterized at during optimization",
+};
+
+const MODE: ParamInfo = ParamInfo {
+    name: "mode",
+    default: "single",
+    kind: ParamKind::Choice(&["single", "joint"]),
+    help: "single: k buffers for each clip; joint: k buffers shared by all clips",
+};
+
+const ITERATIONS: ParamInfo = ParamInfo {
+    name: "iterations",
+    default: "50",
+    kind: ParamKind::Int { min: 1, max: 1000 },
+    help: "most node-assignment rounds before stopping unconverged (reported)",
+};
 
 pub static METHOD: Method = Method {
     name: "hs17",
@@ -54,37 +88,12 @@ pub static METHOD: Method = Method {
     peer: false,
     per_node: true,
     params: &[
-        ParamInfo {
-            name: "clusters",
-            default: "5",
-            kind: ParamKind::Int { min: 1, max: 64 },
-            help: "k, the number of index buffers (per clip with mode=single)",
-        },
+        CLUSTERS,
         LAMBDA,
-        ParamInfo {
-            name: "views",
-            default: "162",
-            kind: ParamKind::Choice(&["12", "42", "162", "642"]),
-            help: "icosahedron viewpoints optimized for (nodes = keyframes × views)",
-        },
-        ParamInfo {
-            name: "res",
-            default: "128",
-            kind: ParamKind::Int { min: 16, max: 4096 },
-            help: "side of the square images nodes are rasterized at during optimization",
-        },
-        ParamInfo {
-            name: "mode",
-            default: "single",
-            kind: ParamKind::Choice(&["single", "joint"]),
-            help: "single: k buffers for each clip; joint: k buffers shared by all clips",
-        },
-        ParamInfo {
-            name: "iterations",
-            default: "50",
-            kind: ParamKind::Int { min: 1, max: 1000 },
-            help: "most node-assignment rounds before stopping unconverged (reported)",
-        },
+        VIEWS,
+        RES,
+        MODE,
+        ITERATIONS,
         FIFO_CACHE,
         ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "picks the initial viewpoints" },
     ],
@@ -98,13 +107,13 @@ const SEPARATION_TRIES: usize = 100;
 
 fn build(params: &Params) -> Box<dyn Ordering> {
     Box::new(Hs17 {
-        clusters: params.int("clusters") as usize,
-        lambda: params.float("lambda"),
-        views: params.word("views").parse().expect("the schema lists only numbers"),
-        res: params.int("res") as u32,
-        joint: params.word("mode") == "joint",
-        max_iterations: params.int("iterations") as usize,
-        cache: params.int("cache") as u32,
+        clusters: params.int(&CLUSTERS) as usize,
+        lambda: params.float(&LAMBDA),
+        views: params.word(&VIEWS).parse().expect("the schema lists only numbers"),
+        res: params.int(&RES) as u32,
+        joint: params.word(&MODE) == "joint",
+        max_iterations: params.int(&ITERATIONS) as usize,
+        cache: params.int(&FIFO_CACHE) as u32,
         seed: params.seed(),
     })
 }
@@ -121,24 +130,21 @@ struct Hs17 {
 }
 
 impl Ordering for Hs17 {
-    fn order(&self, _: &OrderInput) -> Result<Order> {
-        Err(needs_nodes(METHOD.name))
-    }
-
-    fn order_nodes(&self, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
+    fn order(&self, scene: &Scene) -> Result<Orders> {
         let mut clock = Clock::start();
-        let patches = patches(input.mesh, &input.topology.vertex_triangles, self.cache, self.lambda);
+        let keyframes = &scene.frames;
+        let patches = patches(&scene.mesh, &scene.topology.vertex_triangles, self.cache, self.lambda);
         clock.lap("patches");
         let directions = icosphere_directions(self.views);
-        let cameras: Vec<Camera> = directions.iter().map(|&d| perspective(keyframes.framing(), d)).collect();
-        let scene = Scene { triangles: &input.mesh.triangles, keyframes, patches: &patches, cameras: &cameras };
+        let cameras: Vec<Camera> = directions.iter().map(|&d| perspective(keyframes.framing, d)).collect();
+        let scene = Nodes { triangles: &scene.mesh.triangles, keyframes, patches: &patches, cameras: &cameras };
         let groups: Vec<Range<usize>> = if self.joint {
             std::iter::once(0..keyframes.len()).collect()
         } else {
             keyframes.clips.iter().map(|(_, r)| r.clone()).collect()
         };
 
-        let mut buffers: Vec<Order> = Vec::new();
+        let mut buffers: Vec<Clustered> = Vec::new();
         let mut assignment = vec![0u16; keyframes.len() * cameras.len()];
         let (mut iterations, mut converged) = (0, true);
         for frames in groups {
@@ -160,33 +166,33 @@ impl Ordering for Hs17 {
             }
         }
         let lookup = Lookup::nearest(&directions, &assignment);
-        Ok(NodeOrders { buffers, lookup, iterations: Some(iterations), converged, phases: clock.phases })
+        Ok(Orders { buffers, lookup, iterations: Some(iterations), converged, phases: clock.phases })
     }
 }
 
-/// What every k-means run shares.
-struct Scene<'a> {
+/// What every k-means run shares: the (keyframe, viewpoint) nodes and the patches.
+struct Nodes<'a> {
     triangles: &'a [[u32; 3]],
-    keyframes: &'a Keyframes,
+    keyframes: &'a Frames,
     patches: &'a Clustered,
     cameras: &'a [Camera],
 }
 
-impl Scene<'_> {
+impl Nodes<'_> {
     fn patch_count(&self) -> usize {
         self.patches.cluster_count()
     }
 
-    /// The buffer drawing the patches in `sequence`.
-    fn buffer(&self, sequence: &[usize]) -> Order {
+    /// The buffer drawing the patches in `sequence`, each patch a cluster.
+    fn buffer(&self, sequence: &[usize]) -> Clustered {
         let starts = &self.patches.starts;
-        sequence.iter().flat_map(|&p| &self.patches.order[starts[p]..starts[p + 1]]).copied().collect()
+        Clustered::concat(sequence.iter().map(|&p| &self.patches.order[starts[p]..starts[p + 1]]))
     }
 }
 
 /// One k-means over the nodes of a run of frames.
 struct KMeans {
-    buffers: Vec<Order>,
+    buffers: Vec<Clustered>,
     /// Per node `(frame − first) × views + view`: its cluster.
     assignment: Vec<u16>,
     iterations: usize,
@@ -194,7 +200,7 @@ struct KMeans {
 }
 
 impl Hs17 {
-    fn kmeans(&self, scene: &Scene, frames: Range<usize>, clock: &mut Clock) -> Result<KMeans> {
+    fn kmeans(&self, scene: &Nodes, frames: Range<usize>, clock: &mut Clock) -> Result<KMeans> {
         let views = scene.cameras.len();
         // Patch centroids, patch-major: centroids[p * frames + f].
         let centroids = patch_centroids(scene, frames.clone());
@@ -203,8 +209,8 @@ impl Hs17 {
             centroids.chunks(frame_count).map(|c| c.iter().sum::<Vec3>() / c.len() as f32).collect();
         clock.lap("centroids");
 
-        let mut buffers: Vec<Order> = self
-            .initial_viewpoints(views, scene.cameras)
+        let mut buffers: Vec<Clustered> = self
+            .initial_viewpoints(views, scene.cameras, scene.keyframes.framing.center)
             .iter()
             .map(|&v| scene.buffer(&sort_by_key(&average, |c| c.distance(scene.cameras[v].eye))))
             .collect();
@@ -240,12 +246,13 @@ impl Hs17 {
         }
     }
 
-    /// `clusters` distinct viewpoint indices, drawn with the separation rule.
-    fn initial_viewpoints(&self, views: usize, cameras: &[Camera]) -> Vec<usize> {
+    /// `clusters` distinct viewpoint indices, drawn with the separation rule (directions seen from
+    /// the framing `center`).
+    fn initial_viewpoints(&self, views: usize, cameras: &[Camera], center: Vec3) -> Vec<usize> {
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(self.seed);
         let k = self.clusters.min(views);
         let mut chosen: Vec<usize> = Vec::with_capacity(k);
-        let direction = |v: usize| cameras[v].eye.normalize();
+        let direction = |v: usize| (cameras[v].eye - center).normalize();
         while chosen.len() < k {
             let mut pick = rng.random_range(0..views);
             for _ in 0..SEPARATION_TRIES {
@@ -272,7 +279,7 @@ fn sort_by_key<T>(keys: &[T], key: impl Fn(&T) -> f32) -> Vec<usize> {
 }
 
 /// Per patch, per frame of `frames`: the mean of its triangles' corners.
-fn patch_centroids(scene: &Scene, frames: Range<usize>) -> Vec<Vec3> {
+fn patch_centroids(scene: &Nodes, frames: Range<usize>) -> Vec<Vec3> {
     let starts = &scene.patches.starts;
     (0..scene.patch_count())
         .into_par_iter()
@@ -290,7 +297,7 @@ fn patch_centroids(scene: &Scene, frames: Range<usize>) -> Vec<Vec3> {
 
 /// Every node of `frames` rasterized once: node `(f − first) × views + v` is frame f seen by
 /// camera v. The depth test of any buffer is then replayed from these ([`Contested::passed`]).
-fn rasterize_nodes(scene: &Scene, frames: Range<usize>, res: u32) -> Result<Vec<Contested>> {
+fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<Vec<Contested>> {
     let views = scene.cameras.len();
     (0..frames.len() * views)
         .into_par_iter()
@@ -307,12 +314,12 @@ fn rasterize_nodes(scene: &Scene, frames: Range<usize>, res: u32) -> Result<Vec<
 
 /// Step 1: each node to the buffer with the fewest passing fragments; a node keeps its
 /// `previous` buffer when that one ties for the fewest.
-fn assign(nodes: &[Contested], buffers: &[Order], previous: &[u16], triangles: usize) -> Vec<u16> {
+fn assign(nodes: &[Contested], buffers: &[Clustered], previous: &[u16], triangles: usize) -> Vec<u16> {
     let ranks: Vec<Vec<u32>> = buffers
         .par_iter()
         .map(|b| {
             let mut rank = vec![0; triangles];
-            for (i, &t) in b.iter().enumerate() {
+            for (i, &t) in b.order.iter().enumerate() {
                 rank[t as usize] = i as u32;
             }
             rank

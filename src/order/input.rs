@@ -1,8 +1,9 @@
 //! `input`: the triangles in the order the file stores them — the baseline every paper reports
 //! (Bogomjakov & Gotsman 2002, Table 2 "original"; Nehab et al. 2006 compare against it too).
 
-use super::{Method, Order, OrderInput, Ordering, Params};
+use super::{Method, Order, Ordering, Orders, Params};
 use crate::error::Result;
+use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "input",
@@ -21,7 +22,7 @@ fn build(_: &Params) -> Box<dyn Ordering> {
 struct Input;
 
 impl Ordering for Input {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        Ok((0..input.mesh.triangle_count() as u32).collect())
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        Ok(Orders::from((0..scene.mesh.triangle_count() as u32).collect::<Order>()))
     }
 }

@@ -51,10 +51,17 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use super::hoppe::{LiveLists, NONE, edge_neighbors};
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
-use crate::topology::Csr;
+use crate::mesh::Scene;
+use crate::mesh::topology::{Csr, LiveLists, NONE, edge_neighbors};
+
+const CACHE: ParamInfo = ParamInfo {
+    name: "cache",
+    default: "16",
+    kind: ParamKind::Int { min: 3, max: 128 },
+    help: "FIFO size the order is tuned for",
+};
 
 pub static METHOD: Method = Method {
     name: "kcache",
@@ -62,12 +69,7 @@ pub static METHOD: Method = Method {
     source: "Lin & Yu 2006, IEEE TVCG 12(4), K-Cache-Reorder; Sander et al. 2007, Fig. 1",
     peer: false,
     per_node: false,
-    params: &[ParamInfo {
-        name: "cache",
-        default: "16",
-        kind: ParamKind::Int { min: 3, max: 128 },
-        help: "FIFO size the order is tuned for",
-    }],
+    params: &[CACHE],
     build,
 };
 
@@ -77,7 +79,7 @@ const K2_X10: u64 = 5;
 const K3_X10: u64 = 13;
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    Box::new(KCache { cache: params.int("cache") as u32 })
+    Box::new(KCache { cache: params.int(&CACHE) as u32 })
 }
 
 struct KCache {
@@ -85,11 +87,11 @@ struct KCache {
 }
 
 impl Ordering for KCache {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        let mesh = input.mesh;
-        let across = edge_neighbors(&mesh.triangles, &input.topology.weld);
-        let fans = Fans::new(&mesh.triangles, &across, &input.topology.vertex_triangles);
-        Ok(Reorder::new(&mesh.triangles, &input.topology.vertex_triangles, fans, self.cache).run())
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        let mesh = &scene.mesh;
+        let across = edge_neighbors(&mesh.triangles, &scene.topology.weld);
+        let fans = Fans::new(&mesh.triangles, &across, &scene.topology.vertex_triangles);
+        Ok(Orders::from(Reorder::new(&mesh.triangles, &scene.topology.vertex_triangles, fans, self.cache).run()))
     }
 }
 
@@ -449,7 +451,7 @@ impl<'a> Reorder<'a> {
 mod tests {
     use super::*;
     use crate::mesh::procedural;
-    use crate::topology::Topology;
+    use crate::mesh::topology::Topology;
 
     #[test]
     fn fans_go_around_each_vertex() {

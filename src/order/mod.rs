@@ -5,98 +5,42 @@
 //! `triorder methods`, `eval`, every experiment that says `methods = "all"`, and the conformance
 //! tests (permutation, winding, determinism, bad parameters) pick it up with no other change.
 
+pub mod orders;
 pub mod params;
 
-mod centroid_grid;
-pub mod feedback_arc_set;
+mod curves;
 pub(crate) mod forsyth;
 mod front_to_back;
-mod grid_walk;
-mod hilbert;
 mod hoppe;
 mod hs17;
 mod input;
 mod kcache;
-mod meshopt_fifo;
-mod meshopt_overdraw;
-mod meshopt_vcache;
-mod mla;
-mod nehab;
-pub mod overdraw_graph;
-pub mod per_node;
-pub(crate) mod planar_clusters;
+pub mod meshopt;
+pub mod mla;
+pub mod nehab;
 mod random;
 mod recursive_cut;
 pub(crate) mod sander07;
-mod snake;
 mod strips;
 pub(crate) mod tipsify;
 mod tipsify_per_frame;
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
-use crate::mesh::keyframes::Keyframes;
-use crate::topology::Topology;
+use crate::mesh::Scene;
+pub use orders::{Clustered, Lookup, Orders};
 pub use params::{MethodSpec, ParamInfo, ParamKind, Params};
-pub use per_node::{Lookup, NodeOrders};
 
 /// A draw order: position `i` holds the id of the triangle drawn `i`-th. Always a permutation of
 /// `0..triangle_count`; triangles keep their vertex order (and so their winding).
 pub type Order = Vec<u32>;
 
-/// What an ordering gets: the mesh and the connectivity derived from it once.
-#[derive(Clone, Copy)]
-pub struct OrderInput<'a> {
-    pub mesh: &'a Mesh,
-    pub topology: &'a Topology,
-}
-
 /// A triangle-ordering algorithm with its parameters already bound.
 pub trait Ordering: Send + Sync {
-    fn order(&self, input: &OrderInput) -> Result<Order>;
-
-    /// The order with the clusters it was built from, for methods that draw clusters one after
-    /// another (figures colour them); any other method is one cluster.
-    fn clustered(&self, input: &OrderInput) -> Result<Clustered> {
-        Ok(Clustered::single(self.order(input)?))
-    }
-
-    /// The index buffers for drawing `keyframes` (framed poses of `input.mesh`'s connectivity)
-    /// and the table that picks one per keyframe and view direction. A static method orders the
-    /// rest mesh `input.mesh` once and uses that one buffer everywhere, as an engine would ship
-    /// it; keyframe- and view-dependent methods (those registered with `per_node`) override this.
-    fn order_nodes(&self, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
-        Ok(NodeOrders::single(self.order(input)?, keyframes.len()))
-    }
-}
-
-/// A draw order made of clusters drawn one after another: cluster `i` is
-/// `order[starts[i]..starts[i + 1]]`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Clustered {
-    pub order: Order,
-    pub starts: Vec<usize>,
-}
-
-impl Clustered {
-    pub fn single(order: Order) -> Clustered {
-        let starts = vec![0, order.len()];
-        Clustered { order, starts }
-    }
-
-    /// The clusters drawn in the given sequence.
-    pub fn concat<'a>(clusters: impl Iterator<Item = &'a [u32]>) -> Clustered {
-        let (mut order, mut starts) = (Vec::new(), vec![0]);
-        for cluster in clusters {
-            order.extend_from_slice(cluster);
-            starts.push(order.len());
-        }
-        Clustered { order, starts }
-    }
-
-    pub fn cluster_count(&self) -> usize {
-        self.starts.len() - 1
-    }
+    /// Orders the triangles of `scene.mesh`. A static method returns one order
+    /// (`Ok(order.into())`, or a [`Clustered`] order for methods that draw clusters one after
+    /// another); a keyframe- or view-dependent method returns several buffers and the
+    /// [`Lookup`] that picks one per frame of `scene.frames` and view direction.
+    fn order(&self, scene: &Scene) -> Result<Orders>;
 }
 
 /// A registered method: what `triorder methods` shows, and how to build it from checked parameters.
@@ -108,8 +52,9 @@ pub struct Method {
     pub source: &'static str,
     /// True for methods that call another library (the `meshopt` crate) rather than our own code.
     pub peer: bool,
-    /// True for methods whose output is several index buffers chosen per keyframe and view
-    /// ([`Ordering::order_nodes`]); their single-order [`Ordering::order`] is an error.
+    /// True for methods whose [`Orders`] may hold several buffers, picked per frame and view.
+    /// Declared so that what needs one order (`triorder order`, the drawings of a mesh in its
+    /// draw order) can refuse the method before running it.
     pub per_node: bool,
     pub params: &'static [ParamInfo],
     pub build: fn(&Params) -> Box<dyn Ordering>,
@@ -119,8 +64,8 @@ pub struct Method {
 pub static METHODS: &[&Method] = &[
     &input::METHOD,
     &random::METHOD,
-    &snake::METHOD,
-    &hilbert::METHOD,
+    &curves::snake::METHOD,
+    &curves::hilbert::METHOD,
     &recursive_cut::METHOD,
     &mla::METHOD,
     &strips::METHOD,
@@ -128,10 +73,10 @@ pub static METHODS: &[&Method] = &[
     &tipsify::METHOD,
     &forsyth::METHOD,
     &kcache::METHOD,
-    &meshopt_vcache::METHOD,
-    &meshopt_fifo::METHOD,
+    &meshopt::vcache::METHOD,
+    &meshopt::fifo::METHOD,
     &sander07::METHOD,
-    &meshopt_overdraw::METHOD,
+    &meshopt::overdraw::METHOD,
     &nehab::METHOD,
     &front_to_back::METHOD,
     &tipsify_per_frame::METHOD,
@@ -169,59 +114,43 @@ pub fn resolve(spec: &str, run_seed: u64) -> Result<Resolved> {
     Ok(Resolved { method, params, ordering })
 }
 
-/// Runs `resolved` on `input` and checks the result is a permutation, so no caller ever measures
-/// or writes a wrong order silently.
-pub fn run(resolved: &Resolved, input: &OrderInput) -> Result<Order> {
-    let order = resolved.ordering.order(input)?;
-    check_permutation(&order, input.mesh.triangle_count()).map_err(|why| {
-        Error::usage(format!("internal error: `{}` returned an invalid order: {why}", resolved.canonical()))
-    })?;
-    Ok(order)
-}
-
-/// [`run`] keeping the clusters, checked too: they must tile the order.
-pub fn run_clustered(resolved: &Resolved, input: &OrderInput) -> Result<Clustered> {
-    let clustered = resolved.ordering.clustered(input)?;
-    let n = input.mesh.triangle_count();
-    check_permutation(&clustered.order, n)
-        .and_then(
-            |()| if tiles(&clustered.starts, n) { Ok(()) } else { Err("its clusters do not tile the order".into()) },
-        )
-        .map_err(|why| {
-            Error::usage(format!("internal error: `{}` returned an invalid order: {why}", resolved.canonical()))
-        })?;
-    Ok(clustered)
-}
-
-/// [`run`] for every method and any animation: checks that each buffer is a permutation and that
-/// the lookup covers every keyframe with a buffer that exists.
-pub fn run_nodes(resolved: &Resolved, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
-    let nodes = resolved.ordering.order_nodes(input, keyframes)?;
-    let n = input.mesh.triangle_count();
-    let checked = nodes
+/// Runs `resolved` on `scene` and checks what it returns: every buffer a permutation whose
+/// clusters tile it, a lookup for one frame or for every frame of the scene, naming buffers that
+/// exist. So no caller ever measures or writes a wrong order silently.
+pub fn run(resolved: &Resolved, scene: &Scene) -> Result<Orders> {
+    let orders = resolved.ordering.order(scene)?;
+    let n = scene.mesh.triangle_count();
+    let frames = scene.frames.len();
+    let checked = orders
         .buffers
         .iter()
         .enumerate()
-        .try_for_each(|(i, b)| check_permutation(b, n).map_err(|why| format!("buffer {i}: {why}")))
+        .try_for_each(|(i, b)| {
+            check_permutation(&b.order, n)
+                .and_then(|()| if tiles(&b.starts, n) { Ok(()) } else { Err("its clusters do not tile it".into()) })
+                .map_err(|why| format!("buffer {i}: {why}"))
+        })
         .and_then(|()| {
-            if nodes.lookup.frames() != keyframes.len() {
-                Err(format!("its lookup has {} frames for {} keyframes", nodes.lookup.frames(), keyframes.len()))
-            } else if nodes.lookup.cells().iter().any(|&b| usize::from(b) >= nodes.buffers.len()) {
-                Err(format!("its lookup names a buffer beyond its {}", nodes.buffers.len()))
+            if orders.buffers.is_empty() {
+                Err("no buffer".to_string())
+            } else if orders.lookup.frames() != 1 && orders.lookup.frames() != frames {
+                Err(format!("its lookup has {} frames for {frames}", orders.lookup.frames()))
+            } else if orders.lookup.cells().iter().any(|&b| usize::from(b) >= orders.buffers.len()) {
+                Err(format!("its lookup names a buffer beyond its {}", orders.buffers.len()))
             } else {
                 Ok(())
             }
         });
     checked.map_err(|why| {
-        Error::usage(format!("internal error: `{}` returned invalid index buffers: {why}", resolved.canonical()))
+        Error::usage(format!("internal error: `{}` returned invalid orders: {why}", resolved.canonical()))
     })?;
-    Ok(nodes)
+    Ok(orders)
 }
 
-/// The error a per-node method gives when asked for one order.
-pub fn needs_nodes(method: &str) -> Error {
+/// The error for a method with several buffers where one order is needed.
+pub fn needs_one_order(method: &str, what: &str) -> Error {
     Error::usage(format!(
-        "method `{method}` draws with several index buffers chosen per keyframe and view, not one order: \
+        "method `{method}` draws with several index buffers chosen per keyframe and view, not one order, so {what}; \
          measure it with `triorder eval` (add --views; for an animation, --clip), or in an experiment"
     ))
 }

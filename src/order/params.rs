@@ -23,7 +23,10 @@ pub enum ParamKind {
     Seed,
 }
 
-/// One declared parameter of a method.
+/// One declared parameter of a method. Declare each as a `const` and read it with
+/// `params.int(&CONST)` (or `float`, `word`): a misspelt name is then a compile error, and reading
+/// a parameter the schema does not list panics when the method is built, which the conformance
+/// tests do for every registered method.
 #[derive(Debug, Clone, Copy)]
 pub struct ParamInfo {
     pub name: &'static str,
@@ -106,40 +109,39 @@ impl Params {
         Ok(Params { method, values })
     }
 
-    fn get(&self, name: &str) -> &Value {
+    fn get(&self, param: &ParamInfo) -> &Value {
+        self.values.iter().find(|(k, _)| *k == param.name).map(|(_, v)| v).unwrap_or_else(|| {
+            panic!("method `{}` reads `{}`, which its schema does not declare", self.method, param.name)
+        })
+    }
+
+    pub fn int(&self, param: &ParamInfo) -> i64 {
+        match self.get(param) {
+            Value::Int(v) => *v,
+            other => panic!("parameter `{}` of `{}` is {other:?}, not an integer", param.name, self.method),
+        }
+    }
+
+    pub fn float(&self, param: &ParamInfo) -> f64 {
+        match self.get(param) {
+            Value::Float(v) => *v,
+            other => panic!("parameter `{}` of `{}` is {other:?}, not a float", param.name, self.method),
+        }
+    }
+
+    pub fn word(&self, param: &ParamInfo) -> &str {
+        match self.get(param) {
+            Value::Word(v) => v,
+            other => panic!("parameter `{}` of `{}` is {other:?}, not a word", param.name, self.method),
+        }
+    }
+
+    /// The value of the method's [`ParamKind::Seed`] parameter.
+    pub fn seed(&self) -> u64 {
         self.values
             .iter()
-            .find(|(k, _)| *k == name)
-            .map(|(_, v)| v)
-            .unwrap_or_else(|| panic!("method `{}` reads undeclared parameter `{name}`", self.method))
-    }
-
-    pub fn int(&self, name: &str) -> i64 {
-        match self.get(name) {
-            Value::Int(v) => *v,
-            other => panic!("parameter `{name}` of `{}` is {other:?}, not an integer", self.method),
-        }
-    }
-
-    pub fn float(&self, name: &str) -> f64 {
-        match self.get(name) {
-            Value::Float(v) => *v,
-            other => panic!("parameter `{name}` of `{}` is {other:?}, not a float", self.method),
-        }
-    }
-
-    pub fn word(&self, name: &str) -> &str {
-        match self.get(name) {
-            Value::Word(v) => v,
-            other => panic!("parameter `{name}` of `{}` is {other:?}, not a word", self.method),
-        }
-    }
-
-    pub fn seed(&self) -> u64 {
-        match self.get("seed") {
-            Value::Seed(v) => *v,
-            other => panic!("parameter `seed` of `{}` is {other:?}, not a seed", self.method),
-        }
+            .find_map(|(_, v)| if let Value::Seed(seed) = v { Some(*seed) } else { None })
+            .unwrap_or_else(|| panic!("method `{}` reads a seed but declares none", self.method))
     }
 
     /// `name:k=v,...` with every parameter, in schema order: the spec results record.
@@ -190,12 +192,14 @@ pub fn describe_kind(kind: ParamKind) -> String {
 mod tests {
     use super::*;
 
-    const SCHEMA: &[ParamInfo] = &[
-        ParamInfo { name: "cache", default: "16", kind: ParamKind::Int { min: 3, max: 64 }, help: "" },
-        ParamInfo { name: "lambda", default: "0.85", kind: ParamKind::Float { min: 0.0, max: 3.0 }, help: "" },
-        ParamInfo { name: "inner", default: "hoppe", kind: ParamKind::Choice(&["hoppe", "tipsify"]), help: "" },
-        ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "" },
-    ];
+    const CACHE: ParamInfo =
+        ParamInfo { name: "cache", default: "16", kind: ParamKind::Int { min: 3, max: 64 }, help: "" };
+    const LAMBDA: ParamInfo =
+        ParamInfo { name: "lambda", default: "0.85", kind: ParamKind::Float { min: 0.0, max: 3.0 }, help: "" };
+    const INNER: ParamInfo =
+        ParamInfo { name: "inner", default: "hoppe", kind: ParamKind::Choice(&["hoppe", "tipsify"]), help: "" };
+    const SCHEMA: &[ParamInfo] =
+        &[CACHE, LAMBDA, INNER, ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "" }];
 
     fn resolve(spec: &str) -> Result<Params> {
         Params::resolve("m", SCHEMA, &MethodSpec::parse(spec)?, 5)
@@ -205,7 +209,7 @@ mod tests {
     fn defaults_and_canonical_form() {
         assert_eq!(resolve("m").unwrap().canonical(), "m:cache=16,lambda=0.85,inner=hoppe,seed=5");
         let p = resolve("m:lambda=3,cache=32,seed=9").unwrap();
-        assert_eq!((p.int("cache"), p.float("lambda"), p.word("inner"), p.seed()), (32, 3.0, "hoppe", 9));
+        assert_eq!((p.int(&CACHE), p.float(&LAMBDA), p.word(&INNER), p.seed()), (32, 3.0, "hoppe", 9));
     }
 
     #[test]

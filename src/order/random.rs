@@ -5,8 +5,9 @@
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
+use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "random",
@@ -27,9 +28,9 @@ struct Random {
 }
 
 impl Ordering for Random {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        let mut order: Order = (0..input.mesh.triangle_count() as u32).collect();
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        let mut order: Order = (0..scene.mesh.triangle_count() as u32).collect();
         order.shuffle(&mut rand_pcg::Pcg64Mcg::seed_from_u64(self.seed));
-        Ok(order)
+        Ok(Orders::from(order))
     }
 }

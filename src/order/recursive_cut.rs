@@ -44,10 +44,11 @@
 use std::collections::VecDeque;
 use std::sync::Mutex;
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::topology::{Csr, Topology};
+use crate::mesh::Scene;
+use crate::mesh::topology::{Csr, Topology};
 
 pub static METHOD: Method = Method {
     name: "recursive-cut",
@@ -77,8 +78,8 @@ struct RecursiveCut {
 }
 
 impl Ordering for RecursiveCut {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        recursive_cut(input.mesh, input.topology, self.seed)
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        recursive_cut(&scene.mesh, &scene.topology, self.seed).map(Orders::from)
     }
 }
 

@@ -21,10 +21,10 @@
 use glam::{DVec3, Vec3};
 
 use super::tipsify::{FIFO_CACHE, tipsify};
-use super::{Clustered, Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Clustered, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
-use crate::mesh::Mesh;
-use crate::topology::Csr;
+use crate::mesh::topology::Csr;
+use crate::mesh::{Mesh, Scene};
 
 pub static METHOD: Method = Method {
     name: "sander07",
@@ -45,7 +45,7 @@ pub(crate) const LAMBDA: ParamInfo = ParamInfo {
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    Box::new(Sander07 { cache: params.int("cache") as u32, lambda: params.float("lambda") })
+    Box::new(Sander07 { cache: params.int(&FIFO_CACHE) as u32, lambda: params.float(&LAMBDA) })
 }
 
 struct Sander07 {
@@ -54,12 +54,8 @@ struct Sander07 {
 }
 
 impl Ordering for Sander07 {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        Ok(self.clustered(input)?.order)
-    }
-
-    fn clustered(&self, input: &OrderInput) -> Result<Clustered> {
-        Ok(sander07(input.mesh, &input.topology.vertex_triangles, self.cache, self.lambda))
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        Ok(sander07(&scene.mesh, &scene.topology.vertex_triangles, self.cache, self.lambda).into())
     }
 }
 

@@ -17,12 +17,13 @@
 //! corner) would vanish: they are kept out of the strip and drawn after it, in input order.
 //! Strip triangles come back rotated but with their winding (the stripifier only joins a
 //! triangle through an edge in the direction the strip's parity needs);
-//! [`peer::order_from_index_buffer`] accepts rotations and rejects anything else, so a wrong
+//! [`order_from_index_buffer`] accepts rotations and rejects anything else, so a wrong
 //! strip would be an error, never a silently flipped triangle.
 
-use super::{Method, Order, OrderInput, Ordering, Params};
+use super::meshopt::order_from_index_buffer;
+use super::{Method, Ordering, Orders, Params};
 use crate::error::{Error, Result};
-use crate::peer;
+use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "strips",
@@ -45,8 +46,8 @@ struct Strips;
 const NO_RESTART: u32 = 0;
 
 impl Ordering for Strips {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        let mesh = input.mesh;
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        let mesh = &scene.mesh;
         let degenerate = |t: &[u32; 3]| t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
         let proper: Vec<u32> = mesh.triangles.iter().filter(|t| !degenerate(t)).flatten().copied().collect();
         let peer_error = |e: meshopt::Error| Error::usage(format!("internal error: meshopt stripify failed: {e}"));
@@ -62,6 +63,6 @@ impl Ordering for Strips {
             meshopt::unstripify(&strip, NO_RESTART).map_err(peer_error)?
         };
         list.extend(mesh.triangles.iter().filter(|t| degenerate(t)).flatten());
-        peer::order_from_index_buffer(mesh, input.topology, &list)
+        order_from_index_buffer(mesh, &scene.topology, &list).map(Orders::from)
     }
 }

@@ -14,9 +14,10 @@
 //! the start vertex is 0 and the cursor runs over vertex ids in order, so the result depends on
 //! vertex numbering, as in the paper.
 
-use super::{Method, Order, OrderInput, Ordering, ParamInfo, ParamKind, Params};
+use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
-use crate::topology::Csr;
+use crate::mesh::Scene;
+use crate::mesh::topology::Csr;
 
 pub static METHOD: Method = Method {
     name: "tipsify",
@@ -38,7 +39,7 @@ pub(super) const FIFO_CACHE: ParamInfo = ParamInfo {
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    Box::new(Tipsify { cache: params.int("cache") as u32 })
+    Box::new(Tipsify { cache: params.int(&FIFO_CACHE) as u32 })
 }
 
 struct Tipsify {
@@ -46,8 +47,8 @@ struct Tipsify {
 }
 
 impl Ordering for Tipsify {
-    fn order(&self, input: &OrderInput) -> Result<Order> {
-        Ok(tipsify(&input.mesh.triangles, &input.topology.vertex_triangles, self.cache).0)
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        Ok(Orders::from(tipsify(&scene.mesh.triangles, &scene.topology.vertex_triangles, self.cache).0))
     }
 }
 
@@ -55,7 +56,7 @@ impl Ordering for Tipsify {
 const NONE: u32 = u32::MAX;
 
 /// Tipsify with a FIFO of `cache` entries over `triangles`, whose vertex→triangle adjacency is
-/// `vertex_triangles` (as [`crate::topology::vertex_triangles`] builds it). Returns the order and
+/// `vertex_triangles` (as [`crate::mesh::topology::vertex_triangles`] builds it). Returns the order and
 /// the positions in it where a dead end forced a jump (the first triangle of each run that did
 /// not continue from the previous fan's neighbourhood; position 0 included). Those are the hard
 /// cluster boundaries of the paper's fast linear clustering (§4), which `sander07` will cut at.
@@ -232,8 +233,8 @@ fn next_after_dead_end(dead_end: &[u32], top: &mut usize, cursor: &mut usize, ve
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::topology::vertex_triangles;
     use crate::mesh::{Mesh, procedural};
-    use crate::topology::vertex_triangles;
 
     #[test]
     fn dead_ends_mark_the_jumps() {

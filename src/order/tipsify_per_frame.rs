@@ -10,12 +10,11 @@
 
 use rayon::prelude::*;
 
-use super::per_node::{Lookup, NodeOrders};
 use super::sander07::{LAMBDA, dot_rule_sort, patches};
 use super::tipsify::FIFO_CACHE;
-use super::{Clustered, Method, Order, OrderInput, Ordering, Params, needs_nodes};
+use super::{Clustered, Lookup, Method, Ordering, Orders, Params};
 use crate::error::Result;
-use crate::mesh::keyframes::Keyframes;
+use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "tipsify-per-frame",
@@ -28,7 +27,7 @@ pub static METHOD: Method = Method {
 };
 
 fn build(params: &Params) -> Box<dyn Ordering> {
-    Box::new(TipsifyPerFrame { cache: params.int("cache") as u32, lambda: params.float("lambda") })
+    Box::new(TipsifyPerFrame { cache: params.int(&FIFO_CACHE) as u32, lambda: params.float(&LAMBDA) })
 }
 
 struct TipsifyPerFrame {
@@ -37,29 +36,20 @@ struct TipsifyPerFrame {
 }
 
 impl Ordering for TipsifyPerFrame {
-    fn order(&self, _: &OrderInput) -> Result<Order> {
-        Err(needs_nodes(METHOD.name))
-    }
-
-    fn order_nodes(&self, input: &OrderInput, keyframes: &Keyframes) -> Result<NodeOrders> {
-        let mesh = input.mesh;
-        let patches = patches(mesh, &input.topology.vertex_triangles, self.cache, self.lambda);
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        let mesh = &scene.mesh;
+        let patches = patches(mesh, &scene.topology.vertex_triangles, self.cache, self.lambda);
         let clusters: Vec<&[u32]> = patches.starts.windows(2).map(|w| &patches.order[w[0]..w[1]]).collect();
-        let buffers: Vec<Order> = keyframes
+        let buffers: Vec<Clustered> = scene
+            .frames
             .frames
             .par_iter()
             .map(|positions| {
                 let sorted = dot_rule_sort(positions, &mesh.triangles, &clusters);
-                Clustered::concat(sorted.iter().map(|&c| clusters[c])).order
+                Clustered::concat(sorted.iter().map(|&c| clusters[c]))
             })
             .collect();
-        let frame_ids: Vec<u16> = (0..keyframes.len()).map(|f| f as u16).collect();
-        Ok(NodeOrders {
-            buffers,
-            lookup: Lookup::per_frame(&frame_ids),
-            iterations: None,
-            converged: true,
-            phases: vec![],
-        })
+        let frame_ids: Vec<u16> = (0..scene.frames.len()).map(|f| f as u16).collect();
+        Ok(Orders { buffers, lookup: Lookup::per_frame(&frame_ids), iterations: None, converged: true, phases: vec![] })
     }
 }

@@ -87,6 +87,22 @@ pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Ca
     Ok(seen)
 }
 
+/// The fragments that pass the depth test at each pixel (row-major, row 0 at the bottom) when
+/// `triangles` are drawn in order: the overdraw picture of one view, counted under exactly the
+/// rules [`CpuRaster`] counts by.
+pub fn shaded_per_pixel(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Camera, res: u32) -> Result<Vec<u32>> {
+    check_resolution(res)?;
+    let mut screen = Vec::new();
+    project(positions, camera, res, &mut screen).map_err(Error::usage)?;
+    let mut shaded = vec![0u32; res as usize * res as usize];
+    draw(&screen, triangles, res, &mut Vec::new(), |f| {
+        if f.passed {
+            shaded[f.pixel as usize] += 1
+        }
+    });
+    Ok(shaded)
+}
+
 /// One front-facing fragment: which pixel, which triangle (index into the drawn list), its depth,
 /// and whether it passed the depth test when the list was drawn in order.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,13 +2,12 @@
 //! backend), returning the same per-view counts under the same rules so they can be cross-checked.
 
 pub mod cpu;
-pub mod gpu;
 pub mod views;
 
 use glam::Vec3;
 
 use crate::error::Result;
-pub use views::{Camera, Framing, ViewSet};
+pub use views::{Camera, ViewSet};
 
 /// What one view of one draw order produced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -40,19 +39,4 @@ pub trait RasterBackend: Sync {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>>;
-}
-
-/// The backend named `name`: `cpu` (the reference) or `gpu` (opens the Vulkan device; fails with
-/// advice when there is none).
-pub fn backend(name: &str) -> Result<Box<dyn RasterBackend>> {
-    check_backend_name(name)?;
-    Ok(if name == "gpu" { Box::new(gpu::GpuRaster::new()?) } else { Box::new(cpu::CpuRaster) })
-}
-
-/// Checks a backend name without opening anything (specs are validated before any work).
-pub fn check_backend_name(name: &str) -> Result<()> {
-    match name {
-        "cpu" | "gpu" => Ok(()),
-        other => Err(crate::Error::usage(format!("unknown raster backend `{other}` (available: cpu, gpu)"))),
-    }
 }

@@ -23,6 +23,7 @@ use glam::{Mat4, Vec3};
 use rand::{Rng, SeedableRng};
 
 use crate::error::{Error, Result};
+use crate::mesh::Framing;
 
 /// One view: a world → clip transform (depth 0..1, y up) and where the eye is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,23 +50,15 @@ impl Camera {
     }
 }
 
-/// How a model is framed: bounding-box centre and the largest vertex distance from it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Framing {
-    pub center: Vec3,
-    pub radius: f32,
-}
+/// The image side at which drawings of a mesh are rasterized (and the measurements they show,
+/// such as the overdraw picture, are saved by the run): about 1.4 image pixels per figure pixel
+/// for a mesh filling a panel.
+pub const DRAWING_RES: u32 = 1024;
 
-impl Framing {
-    pub fn of(positions: &[Vec3]) -> Framing {
-        let (lo, hi) = positions
-            .iter()
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let center = (lo + hi) * 0.5;
-        let radius = positions.iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
-        // A single point or a degenerate mesh still needs a non-empty view volume.
-        Framing { center, radius: if radius > 0.0 { radius } else { 1.0 } }
-    }
+/// The camera a drawing sees `positions` with: orthographic along `view` (centre → eye), the
+/// model framed as for measurements.
+pub fn drawing_camera(positions: &[Vec3], view: [f32; 3]) -> Camera {
+    orthographic(Framing::of(positions), Vec3::from(view).normalize())
 }
 
 /// A named set of views.

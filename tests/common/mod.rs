@@ -23,43 +23,48 @@ pub const STATIC_MODELS: [&str; 13] = [
     "rocker-arm.obj",
 ];
 
-/// The shared data directory (`$TRIORDER_DATA`, else ../shared/data beside the crate), if present.
-pub fn data_dir() -> Option<PathBuf> {
+/// Why tests on real meshes are ignored (`#[cfg_attr(not(triorder_data), ignore = …)]`): the build
+/// found no data directory (see build.rs).
+pub const NEEDS_DATA: &str = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)";
+
+/// The shared data directory (`$TRIORDER_DATA`, else ../shared/data beside the crate). Tests that
+/// call it are ignored where the build found none; if it is gone since, or TRIORDER_REQUIRE_DATA
+/// made them run without it, they fail here, saying so.
+pub fn data_dir() -> PathBuf {
     let dir = std::env::var_os("TRIORDER_DATA")
+        .filter(|d| !d.is_empty())
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("note: no data directory at {}; skipping tests on real meshes", dir.display());
-        None
-    }
+    assert!(dir.is_dir(), "no data directory at {}: {NEEDS_DATA}", dir.display());
+    dir
 }
 
-/// Loads `models/NAME` from the data directory, or `None` (with a notice) when there is none.
-pub fn real_mesh(name: &str) -> Option<Mesh> {
-    let path = data_dir()?.join("models").join(name);
-    Some(load::load_file(&path).unwrap_or_else(|e| panic!("{e}")))
+/// Loads `models/NAME` from the data directory.
+pub fn real_mesh(name: &str) -> Mesh {
+    let path = data_dir().join("models").join(name);
+    load::load_file(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The GPU raster backend, opened once per test binary, or `None` with a notice when this machine
-/// has no Vulkan adapter. With `TRIORDER_REQUIRE_GPU` set (CI sets it, after installing Mesa's
-/// lavapipe) a missing adapter fails the test instead of skipping it.
-pub fn gpu() -> Option<&'static triorder::raster::gpu::GpuRaster> {
-    static GPU: std::sync::OnceLock<Option<triorder::raster::gpu::GpuRaster>> = std::sync::OnceLock::new();
-    GPU.get_or_init(|| available(triorder::raster::gpu::GpuRaster::new())).as_ref()
+/// `animated/NAME` in the data directory.
+pub fn animated_file(name: &str) -> PathBuf {
+    data_dir().join("animated").join(name)
 }
 
-/// A GPU part that opened, or `None` with a notice; a failure with `TRIORDER_REQUIRE_GPU` set.
-pub fn available<T>(opened: triorder::Result<T>) -> Option<T> {
-    match opened {
-        Ok(part) => Some(part),
-        Err(e) if std::env::var_os("TRIORDER_REQUIRE_GPU").is_some() => panic!("TRIORDER_REQUIRE_GPU is set: {e}"),
-        Err(e) => {
-            eprintln!("note: skipping a GPU test: {e}");
-            None
-        }
-    }
+/// The GPU raster backend, opened once per test binary. Tests that call it are ignored where the
+/// build found no Vulkan driver (`triorder_gpu`, see build.rs); with one, a device that does not
+/// open fails the test with the reason.
+pub fn gpu() -> &'static triorder::gpu::raster::GpuRaster {
+    static GPU: std::sync::OnceLock<triorder::Result<triorder::gpu::raster::GpuRaster>> = std::sync::OnceLock::new();
+    GPU.get_or_init(triorder::gpu::raster::GpuRaster::new).as_ref().unwrap_or_else(|e| opened(e))
+}
+
+/// A GPU part that must open on a machine with a driver.
+pub fn available<T>(opened_part: triorder::Result<T>) -> T {
+    opened_part.unwrap_or_else(|e| opened(&e))
+}
+
+fn opened(e: &triorder::Error) -> ! {
+    panic!("a Vulkan driver is installed but the GPU does not open: {e}")
 }
 
 /// Writes `text` as `ROOT/experiments/ID.toml` and returns its path.
@@ -71,12 +76,13 @@ pub fn write_spec(root: &std::path::Path, id: &str, text: &str) -> std::path::Pa
     path
 }
 
-/// Every raster backend this machine can run: the CPU reference, then the GPU when there is one.
+/// Every raster backend this machine can run: the CPU reference, then the GPU where the build
+/// found a Vulkan driver (`triorder_gpu`).
 pub fn backends() -> Vec<&'static dyn triorder::raster::RasterBackend> {
     static CPU: triorder::raster::cpu::CpuRaster = triorder::raster::cpu::CpuRaster;
     let mut all: Vec<&'static dyn triorder::raster::RasterBackend> = vec![&CPU];
-    if let Some(gpu) = gpu() {
-        all.push(gpu);
+    if cfg!(triorder_gpu) {
+        all.push(gpu());
     }
     all
 }
@@ -86,4 +92,12 @@ pub fn csv_rows(path: &std::path::Path) -> Vec<std::collections::HashMap<String,
     let mut reader = csv::Reader::from_path(path).unwrap();
     let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
     reader.records().map(|r| header.iter().cloned().zip(r.unwrap().iter().map(String::from)).collect()).collect()
+}
+
+/// Runs `resolved` (a static method) on `mesh` as every command does, checked, and returns its
+/// one order.
+pub fn static_order(resolved: &triorder::order::Resolved, mesh: &Mesh) -> triorder::Result<triorder::order::Order> {
+    let scene = triorder::mesh::Scene::still(mesh.clone());
+    let orders = triorder::order::run(resolved, &scene)?;
+    Ok(orders.single().expect("a static method gives one order").order.clone())
 }

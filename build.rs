@@ -1,0 +1,42 @@
+//! Tells the tests what this machine has, at build time, so that a test needing the shared models
+//! or a Vulkan driver is reported by `cargo test` itself as ignored, with the reason, where they
+//! are absent, rather than passing without checking anything.
+//!
+//! - `triorder_data`: a data directory was found, as the tests look for it: `TRIORDER_DATA`, else
+//!   `../shared/data` beside the crate.
+//! - `triorder_gpu`: a Vulkan driver is installed (an ICD manifest where the loader looks, or one
+//!   named by `VK_DRIVER_FILES` / `VK_ICD_FILENAMES`).
+//!
+//! `TRIORDER_REQUIRE_DATA` and `TRIORDER_REQUIRE_GPU` (CI sets both) turn the cfg on regardless,
+//! so a missing directory or driver fails the tests with a clear message instead. Cargo reruns
+//! this when one of these variables changes; after fetching the models into a new directory, set
+//! `TRIORDER_DATA` to it.
+
+use std::path::{Path, PathBuf};
+
+fn main() {
+    println!("cargo::rustc-check-cfg=cfg(triorder_data)");
+    println!("cargo::rustc-check-cfg=cfg(triorder_gpu)");
+    println!("cargo::rerun-if-changed=build.rs");
+    for var in ["TRIORDER_DATA", "TRIORDER_REQUIRE_DATA", "TRIORDER_REQUIRE_GPU", "VK_DRIVER_FILES", "VK_ICD_FILENAMES"]
+    {
+        println!("cargo::rerun-if-env-changed={var}");
+    }
+    let set = |var: &str| std::env::var_os(var).is_some_and(|v| !v.is_empty());
+    let data = std::env::var_os("TRIORDER_DATA")
+        .filter(|d| !d.is_empty())
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    if set("TRIORDER_REQUIRE_DATA") || data.is_dir() {
+        println!("cargo::rustc-cfg=triorder_data");
+    }
+    let named = ["VK_DRIVER_FILES", "VK_ICD_FILENAMES"].iter().any(|v| set(v));
+    let manifests = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d"]
+        .iter()
+        .filter_map(|dir| std::fs::read_dir(dir).ok())
+        .flatten()
+        .any(|entry| entry.is_ok_and(|e| e.path().extension().is_some_and(|x| x == "json")));
+    if set("TRIORDER_REQUIRE_GPU") || named || manifests {
+        println!("cargo::rustc-cfg=triorder_gpu");
+    }
+}

@@ -1,0 +1,322 @@
+//! The `[figure]` table of an experiment spec: what kind of figure, which metric against which
+//! column, series and facets. Checked when the spec is loaded against what its run will write
+//! ([`Writes`]), so a figure that could not be drawn fails before any work.
+
+use serde::Deserialize;
+
+use super::data;
+use crate::measure;
+use crate::mesh::source;
+use crate::results::COLUMNS;
+
+/// What a spec's run writes, as far as its figure cares.
+pub struct Writes<'a> {
+    /// Every metric name its rows can have.
+    pub metrics: Vec<&'static str>,
+    /// Its method specs, canonical.
+    pub methods: &'a [String],
+    /// Whether some model is an animation (so `source:KEY` columns exist).
+    pub animated: bool,
+}
+
+/// How the figure is drawn from the CSV.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    pub kind: FigureKind,
+    /// The first of [`Figure::metrics`]: the one that names the y axis.
+    pub metric: String,
+    /// Every metric drawn; with more than one, `series` or `facet` is `metric`.
+    pub metrics: Vec<String>,
+    pub x: Option<String>,
+    pub series: String,
+    pub facet: Option<String>,
+    /// `(column, value)` pairs a row must match to be drawn.
+    pub filter: Vec<(String, String)>,
+    pub x_label: Option<String>,
+    pub y_label: Option<String>,
+    pub x_log: bool,
+    pub y_log: bool,
+    pub y_range: Option<(f64, f64)>,
+    /// Bars: `metric:NAME`, the metric written above each bar instead of its value (e.g. the
+    /// iterations an ordering took above its time, Han & Sander 2017 Fig. 5).
+    pub label: Option<String>,
+    /// Drawing kinds: the direction the model is seen from (centre → eye), default +z.
+    pub view: [f32; 3],
+    /// Kind `ratio`: the method names whose values are divided, numerator first.
+    pub ratio: Option<(String, String)>,
+}
+
+/// The chart kinds `triorder plot` draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FigureKind {
+    /// y against a numeric x, one line per series (e.g. ACMR against cache size).
+    Line,
+    /// y against a numeric x, one point per row (e.g. ACMR against ordering time).
+    Scatter,
+    /// Grouped bars: categories on x, one bar per series in each group.
+    Bar,
+    /// Every value of each series sorted ascending (a quantile curve) with its mean dashed, and
+    /// mean, max and variance written in the chart: for per-view overdraw.
+    Distribution,
+    /// A table of numbers: one row per x value, one column per series (the papers' tables).
+    Table,
+    /// Each (model, method) drawn as its triangles coloured by position in the sequence, with the
+    /// path through their centroids (Bogomjakov & Gotsman 2002, Figs. 2 and 4). Needs the
+    /// orders, which runs of drawing specs save next to the CSV.
+    Sequence,
+    /// Each (model, method, cache) drawn with every triangle corner coloured by whether its vertex
+    /// hit, was loaded the first time, or reloaded (Bogomjakov & Gotsman 2002, Figs. 10 and 11).
+    Corners,
+    /// Each (model, method) drawn with its clusters in distinct colours (Nehab et al. 2006, Fig. 3).
+    Clusters,
+    /// Each (model, method) drawn with its clusters shaded black (drawn first) to white (drawn
+    /// last) (Nehab et al. 2006, Fig. 6).
+    #[serde(rename = "cluster-order")]
+    ClusterOrder,
+    /// Each (model, method) drawn as a heat map of the fragments shaded at each pixel from the
+    /// figure's view: darker, more overdraw (Nehab et al. 2006, Fig. 1).
+    Overdraw,
+    /// Which simulated cache model predicts the vertex-shader invocations counted on the GPU
+    /// (caches must list simulated models and `gpu`): every model ranked by its error, and the
+    /// winner's simulated against counted ACMR (issue 6).
+    #[serde(rename = "hardware-fit")]
+    HardwareFit,
+    /// Per view, one method's value over another's (`ratio = [A, B]`) of the x metric against
+    /// that of the y metric, with Pearson's r per series (Nehab et al. 2006, Fig. 10: overdraw
+    /// ratio against render-time ratio, nehab over hoppe).
+    Ratio,
+}
+
+impl FigureKind {
+    /// Kinds whose layout is their own: they read `acmr` rows and take no x or log axes.
+    pub fn fixed_layout(self) -> bool {
+        self.draws_meshes() || self == FigureKind::HardwareFit
+    }
+
+    /// Kinds that draw the meshes themselves and so need the orders saved by the run.
+    pub fn draws_meshes(self) -> bool {
+        matches!(
+            self,
+            FigureKind::Sequence
+                | FigureKind::Corners
+                | FigureKind::Clusters
+                | FigureKind::ClusterOrder
+                | FigureKind::Overdraw
+        )
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFigure {
+    kind: FigureKind,
+    metric: OneOrMany,
+    x: Option<String>,
+    series: Option<String>,
+    facet: Option<String>,
+    #[serde(default)]
+    filter: toml::Table,
+    x_label: Option<String>,
+    y_label: Option<String>,
+    #[serde(default)]
+    x_log: bool,
+    #[serde(default)]
+    y_log: bool,
+    y_range: Option<[f64; 2]>,
+    label: Option<String>,
+    view: Option<[f32; 3]>,
+    ratio: Option<[String; 2]>,
+}
+
+/// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum OneOrMany {
+    One(String),
+    Many(Vec<String>),
+}
+
+impl RawFigure {
+    /// Checks the figure against what the run will write.
+    pub fn check(self, writes: &Writes) -> std::result::Result<Figure, String> {
+        let methods = writes.methods;
+        let metrics = match self.metric {
+            OneOrMany::One(m) => vec![m],
+            OneOrMany::Many(ms) if ms.is_empty() => return Err("figure.metric is an empty list".into()),
+            OneOrMany::Many(ms) => ms,
+        };
+        for name in &metrics {
+            let metric = measure::names().find(|m| m.name == name).ok_or_else(|| {
+                let mut known: Vec<_> = measure::names().map(|m| m.name).collect();
+                known.dedup();
+                format!("figure.metric `{name}` is not a metric the CSV has (metrics: {})", known.join(", "))
+            })?;
+            if !writes.metrics.contains(&metric.name) {
+                return Err(format!("figure.metric = \"{}\" needs {}", metric.name, metric.needs));
+            }
+        }
+        let metric = metrics[0].clone();
+        if metrics.len() > 1 && self.series.as_deref() != Some("metric") && self.facet.as_deref() != Some("metric") {
+            return Err("figure.metric lists several metrics: set figure.series or figure.facet to \"metric\"".into());
+        }
+        // A CSV column; `param:NAME`, a parameter of the spec's methods; `source:KEY`, a key of its
+        // animated models; or, where `metric_ok`, `metric:NAME`, another metric joined on model
+        // and method.
+        let column = |key: &str, name: &str, metric_ok: bool| {
+            if let Some(source_key) = name.strip_prefix("source:") {
+                if !source::KEYS.contains(&source_key) {
+                    return Err(format!(
+                        "{key} `{name}`: `{source_key}` is not a key of an animated model (keys: {})",
+                        source::KEYS.join(", ")
+                    ));
+                }
+                if !writes.animated {
+                    return Err(format!("{key} `{name}`: no model of this spec is an animation (PATH#…)"));
+                }
+                return Ok(());
+            }
+            if let Some(param) = name.strip_prefix("param:") {
+                if methods.iter().any(|m| data::parameter(m, param).is_some()) {
+                    return Ok(());
+                }
+                return Err(format!("{key} `{name}`: no method of this spec has a parameter `{param}`"));
+            }
+            if let Some(other) = name.strip_prefix("metric:").filter(|_| metric_ok) {
+                if measure::names().any(|m| m.name == other) {
+                    return Ok(());
+                }
+                return Err(format!("{key} `{name}`: `{other}` is not a metric"));
+            }
+            if COLUMNS.contains(&name) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{key} `{name}` is not a CSV column (columns: {}; or param:NAME, source:KEY{})",
+                    COLUMNS.join(", "),
+                    if metric_ok { ", metric:NAME" } else { "" }
+                ))
+            }
+        };
+        let view = match (self.kind.draws_meshes(), self.view) {
+            (false, Some(_)) => return Err("figure.view is only for the kinds that draw meshes".into()),
+            (true, Some(v)) if !(v.iter().all(|c| c.is_finite()) && v.iter().any(|&c| c != 0.0)) => {
+                return Err(format!("figure.view = {v:?} must be a finite, non-zero direction"));
+            }
+            (_, v) => v.unwrap_or([0.0, 0.0, 1.0]),
+        };
+        if self.kind.fixed_layout() && metrics != ["acmr"] {
+            return Err(format!(
+                "figure.metric = {metrics:?}: kind = \"{}\" reads ACMR, so metric must be \"acmr\"",
+                kind_name(self.kind)
+            ));
+        }
+        match (self.kind, &self.x) {
+            (k, Some(_)) if k.fixed_layout() => {
+                return Err(format!("figure.x is not used by kind = \"{}\": remove it", kind_name(k)));
+            }
+            (k, None) if k.fixed_layout() => {}
+            (FigureKind::Distribution, Some(_)) => {
+                return Err(
+                    "figure.x is not used by kind = \"distribution\" (it sorts the values itself): remove it".into()
+                );
+            }
+            (FigureKind::Distribution, None) => {}
+            (_, None) => return Err(format!("figure.x is required for kind = \"{}\"", kind_name(self.kind))),
+            (k, Some(x)) => column("figure.x", x, matches!(k, FigureKind::Scatter | FigureKind::Ratio))?,
+        }
+        if (self.x_log || self.y_log) && (self.kind == FigureKind::Table || self.kind.fixed_layout()) {
+            return Err(format!("figure.x_log / y_log: kind = \"{}\" has no axes", kind_name(self.kind)));
+        }
+        if self.x_log && matches!(self.kind, FigureKind::Bar | FigureKind::Distribution) {
+            return Err(format!("figure.x_log: kind = \"{}\" has no numeric x axis", kind_name(self.kind)));
+        }
+        let series = self.series.unwrap_or_else(|| "method".into());
+        column("figure.series", &series, false)?;
+        if let Some(facet) = &self.facet {
+            column("figure.facet", facet, false)?;
+        }
+        let mut filter = Vec::new();
+        for (key, value) in self.filter {
+            column("figure.filter key", &key, false)?;
+            let value = match value {
+                toml::Value::String(s) => s,
+                toml::Value::Integer(i) => i.to_string(),
+                toml::Value::Boolean(b) => b.to_string(),
+                other => return Err(format!("figure.filter.{key} = {other}: expected a string, integer or boolean")),
+            };
+            filter.push((key, value));
+        }
+        if let Some(label) = &self.label {
+            if self.kind != FigureKind::Bar {
+                return Err(format!("figure.label is for kind = \"bar\", not \"{}\"", kind_name(self.kind)));
+            }
+            if !label.starts_with("metric:") {
+                return Err(format!("figure.label `{label}`: expected metric:NAME"));
+            }
+            column("figure.label", label, true)?;
+        }
+        let ratio = match (self.kind, self.ratio) {
+            (FigureKind::Ratio, None) => {
+                return Err("figure.ratio = [A, B] (method names) is required for kind = \"ratio\"".into());
+            }
+            (FigureKind::Ratio, Some([a, b])) => {
+                let names: Vec<&str> = methods.iter().map(|m| m.split(':').next().unwrap_or(m)).collect();
+                if let Some(missing) = [&a, &b].into_iter().find(|n| !names.contains(&n.as_str())) {
+                    return Err(format!("figure.ratio names `{missing}`, which is not a method of this spec"));
+                }
+                if !self.x.as_deref().is_some_and(|x| x.starts_with("metric:")) || metrics.len() != 1 {
+                    return Err("kind = \"ratio\" needs x = \"metric:NAME\" and one metric, both per view".into());
+                }
+                Some((a, b))
+            }
+            (_, Some(_)) => {
+                return Err(format!("figure.ratio is for kind = \"ratio\", not \"{}\"", kind_name(self.kind)));
+            }
+            (_, None) => None,
+        };
+        let y_range = match self.y_range {
+            Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
+                return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
+            }
+            Some([lo, _]) if self.y_log && lo <= 0.0 => {
+                return Err(format!("figure.y_range starts at {lo}, but a log axis needs values > 0"));
+            }
+            r => r.map(|[lo, hi]| (lo, hi)),
+        };
+        Ok(Figure {
+            kind: self.kind,
+            metric,
+            metrics,
+            x: self.x,
+            series,
+            facet: self.facet,
+            filter,
+            x_label: self.x_label,
+            y_label: self.y_label,
+            x_log: self.x_log,
+            y_log: self.y_log,
+            y_range,
+            label: self.label,
+            view,
+            ratio,
+        })
+    }
+}
+
+pub fn kind_name(kind: FigureKind) -> &'static str {
+    match kind {
+        FigureKind::Line => "line",
+        FigureKind::Scatter => "scatter",
+        FigureKind::Bar => "bar",
+        FigureKind::Distribution => "distribution",
+        FigureKind::Table => "table",
+        FigureKind::Sequence => "sequence",
+        FigureKind::Clusters => "clusters",
+        FigureKind::ClusterOrder => "cluster-order",
+        FigureKind::Overdraw => "overdraw",
+        FigureKind::Corners => "corners",
+        FigureKind::HardwareFit => "hardware-fit",
+        FigureKind::Ratio => "ratio",
+    }
+}

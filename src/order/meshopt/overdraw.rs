@@ -1,0 +1,43 @@
+//! `meshopt-overdraw` (peer): meshoptimizer's `optimizeOverdraw` on top of `optimizeVertexCache`,
+//! its take on Sander, Nehab & Barczak 2007 §4-5 (linear clustering at cache-flush boundaries,
+//! then clusters sorted by the dot rule). Its threshold differs from the paper's λ: a cluster is
+//! cut once its local ACMR is within `threshold` × the global ACMR.
+
+use super::order_from_index_buffer;
+use crate::error::Result;
+use crate::mesh::Scene;
+use crate::order::{Method, Ordering, Orders, ParamInfo, ParamKind, Params};
+
+const THRESHOLD: ParamInfo = ParamInfo {
+    name: "threshold",
+    default: "1.05",
+    kind: ParamKind::Float { min: 1.0, max: 3.0 },
+    help: "allowed ACMR degradation (1.05 = 5%) in exchange for less overdraw",
+};
+
+pub static METHOD: Method = Method {
+    name: "meshopt-overdraw",
+    summary: "meshoptimizer optimizeVertexCache + optimizeOverdraw (Sander 2007 clustering) [peer]",
+    source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §4-5",
+    peer: true,
+    per_node: false,
+    params: &[THRESHOLD],
+    build,
+};
+
+fn build(params: &Params) -> Box<dyn Ordering> {
+    Box::new(MeshoptOverdraw { threshold: params.float(&THRESHOLD) as f32 })
+}
+
+struct MeshoptOverdraw {
+    threshold: f32,
+}
+
+impl Ordering for MeshoptOverdraw {
+    fn order(&self, scene: &Scene) -> Result<Orders> {
+        let mesh = &scene.mesh;
+        let mut indices = meshopt::optimize_vertex_cache(&mesh.index_buffer(), mesh.vertex_count());
+        meshopt::optimize_overdraw_in_place(&mut indices, &mesh.meshopt_positions(), self.threshold);
+        order_from_index_buffer(mesh, &scene.topology, &indices).map(Orders::from)
+    }
+}

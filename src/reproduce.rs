@@ -1,0 +1,82 @@
+//! `reproduce` and `plot`: what drives both the runs ([`crate::experiment`]) and the figures
+//! ([`crate::figure`]), so neither calls the other.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use indicatif::ProgressBar;
+
+use crate::error::{Error, Result};
+use crate::experiment::run::{bars, run_spec, style};
+use crate::experiment::{RunOptions, Spec};
+use crate::figure::{self, PlotOptions};
+
+/// Draws the figure of the spec at `spec` from its results; returns the SVG's path.
+pub fn plot(spec: &Path, opts: &PlotOptions) -> Result<PathBuf> {
+    let spec = Spec::load(spec)?;
+    figure::plot(&spec.chart(opts))
+}
+
+/// What [`reproduce`] did.
+#[derive(Debug, Clone, Default)]
+pub struct Outcome {
+    /// Each spec run and plotted: its id, CSV and SVG.
+    pub ran: Vec<(String, PathBuf, PathBuf)>,
+    /// Each spec skipped, and why.
+    pub skipped: Vec<(String, String)>,
+    /// The GPU the specs that needed one ran on, if any did.
+    pub device: Option<String>,
+    /// Wall time of the whole reproduction.
+    pub seconds: f64,
+}
+
+/// Runs and plots every `experiments/*.toml` under `opts.out_dir` whose id contains `filter`, in
+/// file-name order. Every spec is loaded and checked before the first one runs, so a typo in the
+/// last spec does not surface after an hour of work. Specs that ask for the GPU themselves are
+/// skipped, with the reason, where there is none, so every CPU experiment still runs on any
+/// machine (an explicit `--backend gpu` must work).
+pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
+    let start = Instant::now();
+    let dir = opts.out_dir.join("experiments");
+    let entries =
+        std::fs::read_dir(&dir).map_err(|e| Error::input(dir.display(), format!("cannot list experiments: {e}")))?;
+    let mut paths = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| Error::input(dir.display(), e))?.path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    let all = paths.len();
+    paths.retain(|p| filter.is_none_or(|f| p.file_stem().is_some_and(|s| s.to_string_lossy().contains(f))));
+    if paths.is_empty() {
+        let what = filter.map_or(String::new(), |f| format!(" matching `{f}` (of {all})"));
+        return Err(Error::usage(format!("no experiment specs{what} in {}", dir.display())));
+    }
+    let specs = paths.iter().map(|p| Spec::load(p)).collect::<Result<Vec<_>>>()?;
+    let gpu = |spec: &Spec| opts.backend.is_none() && spec.needs_gpu();
+    let device = if specs.iter().any(gpu) { Some(crate::gpu::shared().map(|g| g.describe())) } else { None };
+    let bars = bars(opts.progress);
+    let overall = bars.add(ProgressBar::new(specs.len() as u64));
+    overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));
+    let plot = PlotOptions { quick: opts.quick, out_dir: opts.out_dir.clone(), data: opts.data.clone() };
+    let mut outcome = Outcome::default();
+    for spec in &specs {
+        overall.set_message(spec.id.clone());
+        if let Some(Err(why)) = device.as_ref().filter(|_| gpu(spec)) {
+            overall.suspend(|| eprintln!("skipping {}: it needs a GPU ({why})", spec.id));
+            outcome.skipped.push((spec.id.clone(), format!("it needs a GPU ({why})")));
+            overall.inc(1);
+            continue;
+        }
+        let csv = run_spec(spec, opts, &bars)?;
+        let svg = figure::plot(&spec.chart(&plot))?;
+        outcome.ran.push((spec.id.clone(), csv, svg));
+        overall.inc(1);
+    }
+    overall.finish_and_clear();
+    outcome.device = device.and_then(|d| d.ok());
+    outcome.seconds = start.elapsed().as_secs_f64();
+    Ok(outcome)
+}
