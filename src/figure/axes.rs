@@ -9,8 +9,6 @@ use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::order::METHODS;
-
 pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 pub type DrawResult = std::result::Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
@@ -117,11 +115,13 @@ where
     painter.paint(&mut chart)
 }
 
-/// Colours chosen so that a series keeps its colour from figure to figure: methods by their
-/// place in the registry ([`METHODS`], so `input` is always grey and `random` red), variants of
-/// one method (a parameter grid) in lighter and darker shades of it, anything else by a hash of
-/// its name; two different series of one figure never share a base colour while the palette
-/// lasts.
+/// Colours chosen so that a series keeps its colour from figure to figure, by its name alone:
+/// each family (a method's name without its parameters, or any other series value) prefers the
+/// palette slot its name hashes to; variants of one method (a parameter grid) are lighter and
+/// darker shades of it. Two families of one figure never share a slot while the palette lasts:
+/// where their preferred slots collide, the family first in alphabetical order keeps its slot
+/// and the other takes the next free one. So adding a method to the registry changes no figure
+/// it is not in, and a figure's colours do not depend on its legend order.
 pub struct Colors(Vec<(String, RGBColor)>);
 
 const PALETTE: [RGBColor; 20] = [
@@ -151,20 +151,13 @@ impl Colors {
     /// Colours for the series `names` (in legend order) of the CSV column `column`.
     pub fn new(column: &str, names: &[String]) -> Colors {
         let methods = column == "method" || column == "method_name";
-        // The family a series belongs to, and that family's preferred palette slot.
-        let family = |name: &str| -> (String, usize) {
-            let method = name.split(':').next().unwrap_or(name);
-            match METHODS.iter().position(|m| methods && m.name == method) {
-                Some(i) => (method.to_string(), i % PALETTE.len()),
-                None => (name.to_string(), fnv1a(name) % PALETTE.len()),
-            }
-        };
+        let family = |name: &str| if methods { name.split(':').next().unwrap_or(name) } else { name }.to_string();
+        let mut families: Vec<String> = names.iter().map(|n| family(n)).collect();
+        families.sort();
+        families.dedup();
         let mut slots: Vec<(String, usize)> = Vec::new();
-        for name in names {
-            let (key, mut slot) = family(name);
-            if slots.iter().any(|(k, _)| *k == key) {
-                continue;
-            }
+        for key in families {
+            let mut slot = fnv1a(&key) % PALETTE.len();
             while slots.len() < PALETTE.len() && slots.iter().any(|&(_, s)| s == slot) {
                 slot = (slot + 1) % PALETTE.len();
             }
@@ -173,9 +166,11 @@ impl Colors {
         let colors = names
             .iter()
             .map(|name| {
-                let key = family(name).0;
+                let key = family(name);
                 let slot = slots.iter().find(|(k, _)| *k == key).map_or(0, |&(_, s)| s);
-                let variants: Vec<&String> = names.iter().filter(|n| family(n).0 == key).collect();
+                let mut variants: Vec<&String> = names.iter().filter(|n| family(n) == key).collect();
+                variants.sort_by_key(|n| natural(n));
+                variants.dedup();
                 let k = variants.iter().position(|n| *n == name).unwrap_or(0);
                 (name.clone(), shade(PALETTE[slot], k, variants.len()))
             })
@@ -190,6 +185,24 @@ impl Colors {
     pub fn entries(&self) -> &[(String, RGBColor)] {
         &self.0
     }
+}
+
+/// `text` as runs of letters and numbers, numbers compared by value: `cache=8` before `cache=16`.
+fn natural(text: &str) -> Vec<(String, u64)> {
+    let mut runs = Vec::new();
+    let mut rest = text;
+    while !rest.is_empty() {
+        let digits = rest.find(|c: char| !c.is_ascii_digit()).unwrap_or(rest.len());
+        if digits > 0 {
+            runs.push((String::new(), rest[..digits].parse().unwrap_or(u64::MAX)));
+            rest = &rest[digits..];
+        } else {
+            let letters = rest.find(|c: char| c.is_ascii_digit()).unwrap_or(rest.len());
+            runs.push((rest[..letters].to_string(), 0));
+            rest = &rest[letters..];
+        }
+    }
+    runs
 }
 
 /// Variant `k` of `n` of a colour: from 45% darker to 45% lighter.
@@ -324,12 +337,21 @@ mod tests {
         let names: Vec<String> =
             ["input", "random:seed=0", "meshopt-fifo:cache=8", "meshopt-fifo:cache=16"].map(String::from).to_vec();
         let colors = Colors::new("method", &names);
-        assert_eq!(colors.of("input"), PALETTE[0]);
-        assert_eq!(colors.of("random:seed=0"), PALETTE[1]);
         assert_ne!(colors.of("meshopt-fifo:cache=8"), colors.of("meshopt-fifo:cache=16"));
-        // The same series in another figure, with other company, keeps its colour.
+        let distinct: std::collections::HashSet<_> = names.iter().map(|n| format!("{:?}", colors.of(n))).collect();
+        assert_eq!(distinct.len(), names.len());
+        // The same series in another figure, with other company or in another legend order,
+        // keeps its colour: it comes from its name.
         let alone = Colors::new("method", &["random:seed=0".to_string()]);
-        assert_eq!(alone.of("random:seed=0"), PALETTE[1]);
+        assert_eq!(alone.of("random:seed=0"), colors.of("random:seed=0"));
+        let reversed: Vec<String> = names.iter().rev().cloned().collect();
+        let again = Colors::new("method", &reversed);
+        assert!(names.iter().all(|n| again.of(n) == colors.of(n)));
+        // Every registered method of one figure gets its own colour.
+        let all: Vec<String> = crate::order::METHODS.iter().map(|m| m.name.to_string()).collect();
+        let every = Colors::new("method", &all);
+        let distinct: std::collections::HashSet<_> = all.iter().map(|n| format!("{:?}", every.of(n))).collect();
+        assert_eq!(distinct.len(), all.len());
         let models = Colors::new("model", &["a".to_string(), "b".to_string()]);
         assert_ne!(models.of("a"), models.of("b"));
     }

@@ -1,29 +1,21 @@
 //! Triangle orderings: one file per method, all behind [`Ordering`], found by name in [`METHODS`].
 //!
 //! To add an ordering: write `src/order/<name>.rs` with a `pub static METHOD: Method` (its paper
-//! cited at the top, its parameters declared in the schema) and add one line to [`METHODS`].
-//! `triorder methods`, `eval`, every experiment that says `methods = "all"`, and the conformance
-//! tests (permutation, winding, determinism, bad parameters) pick it up with no other change.
+//! cited at the top, its parameters declared as consts in the schema) and add its name to the
+//! `registry!` list below, which declares the module and lists it in [`METHODS`]. `triorder
+//! methods`, `eval`, every experiment that says `methods = "all"`, and the conformance tests
+//! (well-formed and deterministic orders on every test mesh, what `order` writes, bad
+//! parameters) pick it up with no other change.
+//!
+//! The files here are the methods, except [`orders`] (what a method returns) and [`params`]
+//! (method specs); families that share helpers have a folder: `curves/` (snake, Hilbert),
+//! `meshopt/` (the peers), `mla/` and `nehab/` (their helpers beside them).
 
 pub mod orders;
 pub mod params;
 
-mod curves;
-pub(crate) mod forsyth;
-mod front_to_back;
-mod hoppe;
-mod hs17;
-mod input;
-mod kcache;
+pub mod curves;
 pub mod meshopt;
-pub mod mla;
-pub mod nehab;
-mod random;
-mod recursive_cut;
-pub(crate) mod sander07;
-mod strips;
-pub(crate) mod tipsify;
-mod tipsify_per_frame;
 
 use crate::error::{Error, Result};
 use crate::mesh::Scene;
@@ -60,27 +52,45 @@ pub struct Method {
     pub build: fn(&Params) -> Box<dyn Ordering>,
 }
 
-/// Every method, in the order `triorder methods` lists them.
-pub static METHODS: &[&Method] = &[
-    &input::METHOD,
-    &random::METHOD,
-    &curves::snake::METHOD,
-    &curves::hilbert::METHOD,
-    &recursive_cut::METHOD,
-    &mla::METHOD,
-    &strips::METHOD,
-    &hoppe::METHOD,
-    &tipsify::METHOD,
-    &forsyth::METHOD,
-    &kcache::METHOD,
-    &meshopt::vcache::METHOD,
-    &meshopt::fifo::METHOD,
-    &sander07::METHOD,
-    &meshopt::overdraw::METHOD,
-    &nehab::METHOD,
-    &front_to_back::METHOD,
-    &tipsify_per_frame::METHOD,
-    &hs17::METHOD,
+/// Declares a method's module, unless it lives in a family's folder (`family::method`).
+macro_rules! declare {
+    ($module:ident) => {
+        pub mod $module;
+    };
+    ($family:ident :: $module:ident) => {};
+}
+
+/// The registry: each entry declares its module and lists its `METHOD` in [`METHODS`], in the
+/// order `triorder methods` shows them and `methods = "all"` runs them.
+macro_rules! registry {
+    ($($($segment:ident)::+),* $(,)?) => {
+        $(declare!($($segment)::+);)*
+
+        /// Every method, in the order `triorder methods` lists them.
+        pub static METHODS: &[&Method] = &[$(&$($segment)::+::METHOD),*];
+    };
+}
+
+registry![
+    input,
+    random,
+    curves::snake,
+    curves::hilbert,
+    recursive_cut,
+    mla,
+    strips,
+    hoppe,
+    tipsify,
+    forsyth,
+    kcache,
+    meshopt::vcache,
+    meshopt::fifo,
+    sander07,
+    meshopt::overdraw,
+    nehab,
+    front_to_back,
+    tipsify_per_frame,
+    hs17,
 ];
 
 /// A method spec resolved against the registry: ready to run, with its canonical name.

@@ -147,8 +147,8 @@ impl Fans<'_> {
             count += 1;
             // The two corners other than the fan, in triangle order. Always two, so `top` advances
             // by a constant and the next scan's bounds and these stores' addresses do not wait on
-            // the corner tests (about 15% faster on a 2k-triangle mesh than pushing a variable
-            // count). A degenerate triangle may push the fan vertex itself, or one corner twice:
+            // the corner tests (faster than pushing a variable count; README.md, Performance, has
+            // the measurement). A degenerate triangle may push the fan vertex itself, or one corner twice:
             // the fan vertex is dead whenever the stack is read, and a repeat wins no tie it would
             // not have won alone, so the order is the same.
             let [a, b, c] = triangles[t as usize];
@@ -199,9 +199,8 @@ fn next_neighbour(candidates: &[u32], vertices: &[Vertex], now: u32, cache: u32)
             // `cold_path` keeps this a branch rather than a conditional move, so that the next fan
             // vertex comes from branch prediction and the CPU can start on its fan before this
             // scan is done; with a conditional move each fan waits for the previous scan's last
-            // candidate. On a 2k-triangle mesh, whose branches the predictor learns when it is
-            // ordered repeatedly, that makes the ordering a quarter faster; on large meshes the
-            // mispredictions cost a few percent.
+            // candidate. That pays where the predictor learns the branches (a small mesh ordered
+            // repeatedly) and costs little where it does not (README.md, Performance).
             std::hint::cold_path();
             best = v;
             best_priority = priority;

@@ -538,8 +538,9 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
     fn clusters_of_a_real_mesh_are_flatter_than_breadth_first_ones() {
-        let Some(data) = source::data_dir(None) else { return };
+        let data = source::data_dir(None).expect("no data directory: ../shared/data or TRIORDER_DATA");
         let mesh = crate::mesh::load::load_file(&data.join("models/bunny_2k.ply")).unwrap();
         for (target, seed) in [(16, 0), (32, 1), (64, 2)] {
             let (topology, clusters) = cluster_checked(&mesh, target, seed);
