@@ -14,17 +14,12 @@
 //!    [`Metric::names`] lists the names it reports, with an axis label and what a spec or command
 //!    line must ask for to get it; [`Metric::reported`] says which of them the options ask for;
 //!    [`Metric::measure`] returns them as [`Value`]s from the [`Draws`].
-//! 2. Add `&NAME::METRIC` to [`METRICS`].
+//! 2. Add `NAME` to the `registry!` list, which declares the module and lists it in [`METRICS`].
 //!
 //! That is all: `triorder eval` shows it (table and `--json`), every run writes its rows, and a
 //! spec's figure may name it (`metric = "NAME"`). A metric that needs an option the command line
 //! and specs do not have yet (views, caches, render shadings and the GPU switch exist) adds it to
 //! [`MeasureOptions`] too.
-
-pub mod cache;
-mod gpu_vertices;
-pub mod overdraw;
-mod render;
 
 use std::time::Instant;
 
@@ -37,8 +32,17 @@ use crate::mesh::Scene;
 use crate::order::{self, Orders, Resolved};
 use crate::raster::{Camera, RasterBackend, ViewSet};
 
-/// Every metric, in the order their values are reported (and their rows written).
-pub static METRICS: &[&dyn Metric] = &[&cache::METRIC, &gpu_vertices::METRIC, &overdraw::METRIC, &render::METRIC];
+/// The registry: each entry declares its module and lists its `METRIC` in [`METRICS`].
+macro_rules! registry {
+    ($($module:ident),* $(,)?) => {
+        $(pub mod $module;)*
+
+        /// Every metric, in the order their values are reported (and their rows written).
+        pub static METRICS: &[&dyn Metric] = &[$(&$module::METRIC),*];
+    };
+}
+
+registry![cache, gpu_vertices, overdraw, render];
 
 /// What the ordering itself reports, beside the metrics: every row of a run also carries the
 /// ordering's time, and runs that compare methods with several buffers say how many each needs.
