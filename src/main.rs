@@ -11,11 +11,22 @@ use clap::{Args, Parser, Subcommand};
 /// Triangle-order optimization: reorder meshes, measure vertex-cache misses and overdraw, and
 /// regenerate the figures of the triangle-ordering papers.
 #[derive(Parser)]
-#[command(name = "triorder", version, about, long_about = None, propagate_version = true)]
+#[command(name = "triorder", version, about, long_about = None, propagate_version = true, after_help = EXAMPLES)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    #[command(flatten)]
+    common: Common,
 }
+
+const EXAMPLES: &str = "Examples:
+  triorder reproduce --quick          every experiment on small meshes (no data needed), CSV + SVG
+  triorder eval assets/spot.obj -m tipsify -m nehab:clusters=32 --views ico:42 --res 256
+  triorder order assets/spot.obj -o spot.glb -m meshopt-overdraw
+
+A model named like models/bun_zipper.ply is read from the data directory: --data DIR, else
+$TRIORDER_DATA, else ../shared/data (scripts/fetch-data.sh downloads the models). README.md
+explains every command, metric and figure.";
 
 /// Options shared by every command that reads meshes.
 #[derive(Args, Clone)]
@@ -106,8 +117,6 @@ enum Command {
         remap_vertices: bool,
         #[command(flatten)]
         measure: Measure,
-        #[command(flatten)]
-        common: Common,
     },
     /// Order a mesh with one or more methods and measure each order.
     ///
@@ -127,8 +136,6 @@ enum Command {
         /// One JSON object per method per line instead of a table.
         #[arg(long)]
         json: bool,
-        #[command(flatten)]
-        common: Common,
     },
     /// Run an experiment spec (experiments/*.toml) and write results/ID.csv.
     Run {
@@ -139,8 +146,6 @@ enum Command {
         /// Raster backend for overdraw, overriding the spec's: cpu or gpu (Vulkan through wgpu).
         #[arg(long, value_name = "cpu|gpu")]
         backend: Option<String>,
-        #[command(flatten)]
-        common: Common,
     },
     /// Draw paper-figures/ID.svg from results/ID.csv (no recomputation).
     Plot {
@@ -148,8 +153,6 @@ enum Command {
         /// Plot the quick run's CSV into paper-figures/quick/.
         #[arg(long)]
         quick: bool,
-        #[command(flatten)]
-        common: Common,
     },
     /// Run and plot every experiment in experiments/.
     Reproduce {
@@ -162,8 +165,6 @@ enum Command {
         /// Raster backend for overdraw in every spec: cpu or gpu (Vulkan through wgpu).
         #[arg(long, value_name = "cpu|gpu")]
         backend: Option<String>,
-        #[command(flatten)]
-        common: Common,
     },
     /// Time our metrics and orderings against meshoptimizer (the meshopt crate) in the same run.
     Bench {
@@ -177,27 +178,25 @@ enum Command {
         /// Time one part only. Without it: metrics and orderings (the backends need a GPU).
         #[arg(long, value_enum)]
         only: Option<BenchPart>,
-        #[command(flatten)]
-        common: Common,
     },
 }
 
 fn main() -> ExitCode {
+    quiet_mesa();
     let cli = Cli::parse();
+    let common = &cli.common;
     let result = match cli.command {
         Command::Methods => commands::methods(),
-        Command::Order { input, output, method, remap_vertices, measure, common } => {
-            commands::order(&input, &output, &method, remap_vertices, &measure, &common)
+        Command::Order { input, output, method, remap_vertices, measure } => {
+            commands::order(&input, &output, &method, remap_vertices, &measure, common)
         }
-        Command::Eval { mesh, methods, measure, animation, json, common } => {
-            commands::eval(&mesh, &methods, &measure, &animation, json, &common)
+        Command::Eval { mesh, methods, measure, animation, json } => {
+            commands::eval(&mesh, &methods, &measure, &animation, json, common)
         }
-        Command::Run { spec, quick, backend, common } => commands::run(&spec, quick, backend, &common),
-        Command::Plot { spec, quick, common } => commands::plot(&spec, quick, &common),
-        Command::Reproduce { quick, only, backend, common } => {
-            commands::reproduce(quick, only.as_deref(), backend, &common)
-        }
-        Command::Bench { reps, meshes, only, common } => commands::bench(reps, &meshes, only, &common),
+        Command::Run { spec, quick, backend } => commands::run(&spec, quick, backend, common),
+        Command::Plot { spec, quick } => commands::plot(&spec, quick, common),
+        Command::Reproduce { quick, only, backend } => commands::reproduce(quick, only.as_deref(), backend, common),
+        Command::Bench { reps, meshes, only } => commands::bench(reps, &meshes, only, common),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -205,5 +204,17 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// Mesa's Vulkan drivers print `error: XDG_RUNTIME_DIR is invalid or not set in the environment.`
+/// for every device they open when that variable is unset: they look there for a display server,
+/// which triorder, drawing off-screen, never uses. The message reads as triorder's own, so the
+/// variable is pointed at the temporary directory when it is unset. This runs first, before any
+/// thread exists, which is what makes changing the environment sound.
+fn quiet_mesa() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none_or(|d| d.is_empty()) {
+        // SAFETY: no other thread exists yet to read the environment concurrently.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
     }
 }

@@ -17,6 +17,12 @@ pub fn plot(spec: &Path, opts: &PlotOptions) -> Result<PathBuf> {
     figure::plot(&spec.chart(opts))
 }
 
+/// The device as the summary names it, saying when it is a software rasterizer.
+fn describe(gpu: &crate::gpu::Gpu) -> String {
+    let software = if gpu.is_software() { ", a software rasterizer: its times are the CPU's, not a GPU's" } else { "" };
+    format!("{}{software}", gpu.describe())
+}
+
 /// What [`reproduce`] did.
 #[derive(Debug, Clone, Default)]
 pub struct Outcome {
@@ -56,7 +62,7 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
     }
     let specs = paths.iter().map(|p| Spec::load(p)).collect::<Result<Vec<_>>>()?;
     let gpu = |spec: &Spec| opts.backend.is_none() && spec.needs_gpu();
-    let device = if specs.iter().any(gpu) { Some(crate::gpu::shared().map(|g| g.describe())) } else { None };
+    let device = if specs.iter().any(gpu) { Some(crate::gpu::shared().map(describe)) } else { None };
     let bars = bars(opts.progress);
     let overall = bars.add(ProgressBar::new(specs.len() as u64));
     overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));

@@ -36,7 +36,31 @@ pub fn reproduce(quick: bool, only: Option<&str>, backend: Option<String>, commo
     for (_, csv, svg) in &outcome.ran {
         println!("wrote {} and {}", csv.display(), svg.display());
     }
+    print!("{}", summary(&outcome, quick));
     Ok(())
+}
+
+/// What `reproduce` did, in a few lines: how many specs ran and which were skipped and why, the
+/// GPU the GPU specs used, the time it took, and where the results are.
+fn summary(outcome: &reproduce::Outcome, quick: bool) -> String {
+    let total = outcome.ran.len() + outcome.skipped.len();
+    let (minutes, seconds) = ((outcome.seconds / 60.0).floor(), outcome.seconds % 60.0);
+    let mut out = format!(
+        "\nreproduced {} of {total} specs in {minutes:.0} min {seconds:.0} s{}\n",
+        outcome.ran.len(),
+        if quick { " (quick: procedural models and assets/ only, small view sets)" } else { "" }
+    );
+    for (id, why) in &outcome.skipped {
+        out += &format!("  skipped {id}: {why}\n");
+    }
+    if let Some(device) = &outcome.device {
+        out += &format!("  GPU specs ran on {device}\n");
+    }
+    let sub = if quick { "/quick" } else { "" };
+    out += &format!(
+        "  results in results{sub}/ (CSV), figures in paper-figures{sub}/ (SVG); paper-figures/README.md reads them\n"
+    );
+    out
 }
 
 /// The meshes `bench` times: the large shared models when a data directory exists, else a

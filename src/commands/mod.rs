@@ -63,6 +63,11 @@ fn open(source: &Source, common: &Common) -> Result<Scene> {
 }
 
 pub fn methods() -> Result<()> {
+    println!(
+        "A method is written NAME, or NAME:KEY=VALUE,KEY=VALUE with any of its parameters, e.g.\n  \
+         tipsify:cache=32   nehab:clusters=32,views=42   random:seed=7\n\
+         Parameters left out take the defaults below; --seed is the default of every seed.\n"
+    );
     for m in METHODS {
         let peer = if m.peer { "  [peer]" } else { "" };
         println!("{}{peer}\n    {}\n    source: {}", m.name, m.summary, m.source);

@@ -67,10 +67,11 @@
 //! view = [0, 0, 1]                 # sequence, corners: direction the model is seen from
 //!
 //! [quick]                          # what `--quick` runs: procedural models and assets/ only,
-//! models = ["assets/spot.obj"]     # done in seconds; caches, views and res override the
-//! caches = ["fifo:4..64/4"]        # full run's when given
+//! models = ["assets/spot.obj"]     # done in seconds; caches, views, res and render_frames
+//! caches = ["fifo:4..64/4"]        # override the full run's when given
 //! views = "ico:42"
 //! res = 128
+//! render_frames = 3
 //! ```
 //!
 //! Grids (`{…}`) may appear anywhere in a method or cache spec; each item is a literal or an
@@ -117,8 +118,6 @@ pub struct Spec {
     pub backend: String,
     /// Shaders to time rendering with on the GPU, from every view (`render = ["pixel", "vertex"]`).
     pub render: Vec<Shading>,
-    /// Timed frames per view and shader (`render_frames`, default [`DEFAULT_RENDER_FRAMES`]).
-    pub render_frames: usize,
     /// Canonical method specs (every parameter written out), grids expanded, duplicates
     /// removed, in the order the spec lists them.
     pub methods: Vec<String>,
@@ -145,6 +144,8 @@ pub struct Workload {
     pub gpu_vertices: bool,
     pub views: Option<ViewSet>,
     pub res: u32,
+    /// Timed frames per view and shader when the spec renders.
+    pub render_frames: usize,
 }
 
 impl Spec {
@@ -173,7 +174,7 @@ impl Spec {
             res: work.res,
             seed: self.seed,
             render: self.render.clone(),
-            render_frames: self.render_frames,
+            render_frames: work.render_frames,
         }
     }
 
@@ -282,6 +283,7 @@ struct RawQuick {
     caches: Option<Vec<String>>,
     views: Option<String>,
     res: Option<u32>,
+    render_frames: Option<usize>,
 }
 
 impl RawSpec {
@@ -306,14 +308,17 @@ impl RawSpec {
         let backend = self.backend.unwrap_or_else(|| "cpu".into());
         crate::measure::check_backend_name(&backend).map_err(|e| err(format!("backend: {e}")))?;
 
-        let full = check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res).map_err(err)?;
+        let render_frames = self.render_frames.unwrap_or(DEFAULT_RENDER_FRAMES);
+        let full = check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res, render_frames)
+            .map_err(err)?;
         let quick = match &self.quick {
             None => None,
             Some(q) => {
                 let caches = q.caches.as_ref().unwrap_or(&self.caches);
                 let views = q.views.as_deref().or(self.views.as_deref());
                 let res = q.res.or(self.res);
-                let work = check_workload("quick.", &q.models, caches, views, res).map_err(err)?;
+                let frames = q.render_frames.unwrap_or(render_frames);
+                let work = check_workload("quick.", &q.models, caches, views, res, frames).map_err(err)?;
                 if let Some((i, model)) = work.models.iter().enumerate().find(|(_, m)| !m.source.is_bundled()) {
                     return Err(err(format!(
                         "quick.models[{i}] `{}`: quick runs use procedural models and files under assets/ only, so they work on a fresh clone",
@@ -329,10 +334,6 @@ impl RawSpec {
             .map(|s| Shading::parse(s))
             .collect::<Result<Vec<_>>>()
             .map_err(|e| err(format!("render: {e}")))?;
-        let render_frames = self.render_frames.unwrap_or(DEFAULT_RENDER_FRAMES);
-        if !(1..=MAX_FRAMES).contains(&render_frames) {
-            return Err(err(format!("render_frames = {render_frames} is not in 1..={MAX_FRAMES}")));
-        }
         if !render.is_empty() && (full.views.is_none() || quick.as_ref().is_some_and(|q| q.views.is_none())) {
             return Err(err("render times every view of `views`: set views".into()));
         }
@@ -376,7 +377,6 @@ impl RawSpec {
             seed: self.seed,
             backend,
             render,
-            render_frames,
             methods,
             full,
             quick,
@@ -425,6 +425,7 @@ fn check_workload(
     caches: &[String],
     views: Option<&str>,
     res: Option<u32>,
+    render_frames: usize,
 ) -> std::result::Result<Workload, String> {
     if models.is_empty() {
         return Err(format!("{prefix}models is empty"));
@@ -465,7 +466,10 @@ fn check_workload(
     if parsed.is_empty() && !gpu_vertices && views.is_none() {
         return Err(format!("{prefix}caches is empty and views is not set: nothing to measure but time"));
     }
-    Ok(Workload { models, caches: parsed, gpu_vertices, views, res })
+    if !(1..=MAX_FRAMES).contains(&render_frames) {
+        return Err(format!("{prefix}render_frames = {render_frames} is not in 1..={MAX_FRAMES}"));
+    }
+    Ok(Workload { models, caches: parsed, gpu_vertices, views, res, render_frames })
 }
 
 /// Expands a cache spec: `KIND:LO..HI[/STEP]` is shorthand for `KIND:{LO..HI[/STEP]}`; any

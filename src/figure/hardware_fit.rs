@@ -103,10 +103,9 @@ const TABLE_ROWS: usize = 14;
 pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
     let fits = fits(table)?;
     let best = &fits[0];
-    let device = table.distinct(&["cache", "backend"]).into_iter().find(|r| r[0] == GPU_CACHE).map(|r| r[1].clone());
     let setup = format!(
-        "vertex-shader invocations counted on {} · {} (mesh, ordering) pairs · {} simulated models",
-        device.as_deref().map(|d| d.strip_prefix("gpu: ").unwrap_or(d)).unwrap_or_default(),
+        "vertex-shader invocations {} · {} (mesh, ordering) pairs · {} simulated models",
+        super::measured_on(table).unwrap_or_default(),
         best.points.len(),
         fits.len()
     );

@@ -80,6 +80,8 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         .iter()
         .map(|v| format!("views {} at {}×{} pixels", v[0], v[1], v[1]))
         .collect();
+    setup.extend(measured_on(&table));
+    setup.extend(unindexed(&table));
     if chart.quick {
         setup.push("quick run: small stand-in models, not the paper's".into());
     }
@@ -131,6 +133,39 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         .map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
     save(&path, &svg)?;
     Ok(path)
+}
+
+/// "measured on DEVICE" for the GPUs that counted or timed rows of `table` (their `backend` is
+/// `gpu: DEVICE`), saying when one is a software rasterizer: its counts are exact, but its
+/// vertex reuse and times are the CPU's that emulates a GPU, not a GPU's.
+fn measured_on(table: &Table) -> Option<String> {
+    let mut devices: Vec<String> = Vec::new();
+    for row in table.distinct(&["backend"]) {
+        if let Some(device) = row[0].strip_prefix("gpu: ").filter(|d| !devices.iter().any(|k| k == d)) {
+            devices.push(device.to_string());
+        }
+    }
+    if devices.is_empty() {
+        return None;
+    }
+    let software = ["llvmpipe", "lavapipe", "swiftshader", "softpipe"];
+    let emulated = devices.iter().any(|d| software.iter().any(|s| d.to_lowercase().contains(s)));
+    let note = if emulated { " (a software rasterizer on the CPU, not a GPU)" } else { "" };
+    Some(format!("measured on {}{note}", devices.join(", ")))
+}
+
+/// A note naming the models of `table` with three vertices per triangle: unindexed meshes, which
+/// miss three vertices a triangle in any order (their cache metrics cannot tell orders apart).
+fn unindexed(table: &Table) -> Option<String> {
+    let unindexed: Vec<String> = table
+        .distinct(&["model", "model_triangles", "model_vertices"])
+        .into_iter()
+        .filter(|r| r[1].parse::<usize>().is_ok_and(|t| t > 1 && r[2].parse::<usize>().is_ok_and(|v| v >= 3 * t)))
+        .map(|r| r[0].clone())
+        .collect();
+    (!unindexed.is_empty()).then(|| {
+        format!("{}: no shared vertices (unindexed), so every order misses 3 vertices a triangle", unindexed.join(", "))
+    })
 }
 
 /// Writes a finished figure to `path` atomically, creating its folder.

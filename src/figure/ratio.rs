@@ -76,8 +76,6 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
     let points = points(chart, table)?;
     let (a, b) = figure.ratio.clone().unwrap_or_default();
     let x_metric = figure.x.as_deref().and_then(|x| x.strip_prefix("metric:")).unwrap_or_default();
-    let devices: Vec<String> =
-        table.distinct(&["backend"]).into_iter().filter_map(|r| r[0].strip_prefix("gpu: ").map(String::from)).collect();
     let mut setup = format!(
         "{a} ÷ {b} per view · {}",
         points
@@ -86,7 +84,7 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
             .collect::<Vec<_>>()
             .join(" · ")
     );
-    setup += &format!(" · measured on {}", devices.join(", "));
+    setup.extend(super::measured_on(table).map(|m| format!(" · {m}")));
     if chart.quick {
         setup += " · quick run: small stand-in models, not the paper's";
     }

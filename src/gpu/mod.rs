@@ -122,6 +122,11 @@ impl Gpu {
         format!("{} ({} {})", self.info.name, self.info.driver, self.info.driver_info)
     }
 
+    /// True for a software rasterizer (Mesa's lavapipe): exact counts, but CPU times.
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// True when the adapter offers `features` (pipeline statistics, timestamps).
     pub fn has(&self, features: wgpu::Features) -> bool {
         self.device.features().contains(features)

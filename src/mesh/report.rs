@@ -16,6 +16,8 @@ pub struct MeshReport {
     pub vertices: usize,
     /// Vertices no triangle references.
     pub unused_vertices: usize,
+    /// Vertices that two or more corners reference: the reuse a vertex cache can exploit.
+    pub shared_vertices: usize,
     /// Triangles repeating a vertex index.
     pub repeated_index: usize,
     /// Triangles with three distinct indices but zero area (collinear or coincident positions).
@@ -31,11 +33,11 @@ pub struct MeshReport {
 
 impl MeshReport {
     pub fn new(mesh: &Mesh, topology: &Topology) -> MeshReport {
-        let mut used = vec![false; mesh.vertex_count()];
+        let mut used = vec![0u32; mesh.vertex_count()];
         let mut seen = HashSet::with_capacity(mesh.triangle_count());
         let (mut repeated_index, mut zero_area, mut duplicates) = (0, 0, 0);
         for tri in &mesh.triangles {
-            tri.iter().for_each(|&v| used[v as usize] = true);
+            tri.iter().for_each(|&v| used[v as usize] += 1);
             if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
                 repeated_index += 1;
             } else {
@@ -49,7 +51,8 @@ impl MeshReport {
         MeshReport {
             triangles: mesh.triangle_count(),
             vertices: mesh.vertex_count(),
-            unused_vertices: used.iter().filter(|&&u| !u).count(),
+            unused_vertices: used.iter().filter(|&&u| u == 0).count(),
+            shared_vertices: used.iter().filter(|&&u| u > 1).count(),
             repeated_index,
             zero_area,
             duplicates,
@@ -73,6 +76,11 @@ impl MeshReport {
         .into_iter()
         .filter(|(n, _)| *n > 0)
         .map(|(n, what)| format!("{n} {what}; kept as given"))
+        .chain((self.shared_vertices == 0 && self.triangles > 1).then(|| {
+            "no vertex is shared between triangles (an unindexed mesh): every order misses 3 vertices \
+             per triangle, so vertex-cache metrics cannot tell orders apart; weld its vertices first"
+                .to_string()
+        }))
         .collect()
     }
 }
@@ -118,5 +126,10 @@ mod tests {
         let text = report.to_string();
         assert!(text.contains("1 duplicate triangles; kept as given"), "{text}");
         assert!(text.contains("non-manifold"), "{text}");
+        assert!(!text.contains("unindexed"), "{text}");
+        let soup = Mesh::new("soup", positions[..6].to_vec(), vec![[0, 1, 2], [3, 4, 5]], VertexAttributes::default());
+        let soup = soup.unwrap();
+        let text = MeshReport::new(&soup, &Topology::new(&soup)).to_string();
+        assert!(text.contains("unindexed"), "{text}");
     }
 }
