@@ -117,7 +117,7 @@ mod tests {
             [0, 1, 3], // zero area (collinear)
             [0, 1, 4], // third triangle on edge 0-1 with the first two: non-manifold
         ];
-        let mesh = Mesh::new("m", positions, triangles, VertexAttributes::default()).unwrap();
+        let mesh = Mesh::new("m", positions.clone(), triangles, VertexAttributes::default()).unwrap();
         let report = MeshReport::new(&mesh, &Topology::new(&mesh));
         assert_eq!(report.triangles, 5);
         assert_eq!((report.repeated_index, report.zero_area, report.duplicates), (1, 1, 1));
