@@ -70,8 +70,9 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         commit: provenance::commit(),
         per_view: spec.figure.metrics.iter().any(|m| m == "ovr" || m.ends_with("_view")),
     };
-    // Buffer counts are reported where they can differ between the methods compared.
-    let buffers = methods.iter().any(|m| m.method.per_node) || work.models.iter().any(|m| m.source.is_animation());
+    // Buffer counts are reported where they can differ between the methods compared: for an
+    // animation, and for every model when some method gives several buffers.
+    let per_node = methods.iter().any(|m| m.method.per_node);
 
     let bar = bars.add(ProgressBar::new((work.models.len() * methods.len()) as u64));
     bar.set_style(style("{prefix} {pos}/{len} {bar:30} {elapsed} {wide_msg}"));
@@ -87,6 +88,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         for method in &methods {
             bar.set_message(format!("{} · {}", model.name, method.canonical()));
             let evaluation = measure::evaluate(&scene, method, &options, raster.as_ref())?;
+            let buffers = per_node || scene.frames.animated;
             rows.extend(context.rows(&model.name, &model.source, &scene, &evaluation, buffers));
             if spec.figure.kind.draws_meshes() {
                 orders.push(drawn(spec, &model.name, &scene, &evaluation, &options.caches)?);

@@ -4,7 +4,8 @@
 //! own simplifier; ours differ in shape but not in what the figure asks, which is how an
 //! ordering's ACMR behaves as the triangle count falls.
 //!
-//! A model source `PATH@N` (e.g. `models/bun_zipper.ply@20000`) names the model at N triangles.
+//! A model source `PATH@N` (e.g. `models/bun_zipper.ply@20000`, see [`super::source`]) names the
+//! model at N triangles.
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -12,21 +13,6 @@ use crate::mesh::Mesh;
 /// How far from the requested count a result may land: the simplifier collapses edges in
 /// batches, so it may pass the target by a few triangles, and stops short when no collapse is left.
 const TOLERANCE: f64 = 0.02;
-
-/// Splits `PATH@N` into the base source and the triangle count; `None` when `source` has no such
-/// suffix (an `@` followed by something other than digits is part of a file name).
-pub fn parse_source(source: &str) -> Option<(&str, &str)> {
-    let (base, count) = source.rsplit_once('@')?;
-    (!count.is_empty() && count.bytes().all(|b| b.is_ascii_digit())).then_some((base, count))
-}
-
-/// Checks the `N` of `PATH@N`: a positive triangle count.
-pub fn parse_target(source: &str, count: &str) -> Result<usize> {
-    match count.parse::<usize>() {
-        Ok(n) if n > 0 => Ok(n),
-        _ => Err(Error::input(source, format!("`@{count}`: the target triangle count must be a positive integer"))),
-    }
-}
 
 /// `mesh` simplified to about `target` triangles (within 2%), unused vertices dropped and
 /// the rest numbered in order of first use. Attributes follow their vertices; the simplifier

@@ -49,8 +49,8 @@ impl Source {
         if let Some(animation) = AnimationSource::parse(text) {
             return animation.map(Source::Animation);
         }
-        if let Some((base, count)) = simplify::parse_source(text) {
-            let target = simplify::parse_target(text, count)?;
+        if let Some((base, count)) = parse_simplified(text) {
+            let target = parse_target(text, count)?;
             return Ok(Source::Simplified { base: Box::new(Source::parse(base)?), target });
         }
         match procedural::check(text) {
@@ -126,6 +126,21 @@ impl Source {
             "subdiv" => Some(a.subdiv.to_string()),
             _ => None,
         }
+    }
+}
+
+/// Splits `PATH@N` into the base source and the triangle count; `None` when `source` has no such
+/// suffix (an `@` followed by something other than digits is part of a file name).
+fn parse_simplified(source: &str) -> Option<(&str, &str)> {
+    let (base, count) = source.rsplit_once('@')?;
+    (!count.is_empty() && count.bytes().all(|b| b.is_ascii_digit())).then_some((base, count))
+}
+
+/// Checks the `N` of `PATH@N`: a positive triangle count.
+fn parse_target(source: &str, count: &str) -> Result<usize> {
+    match count.parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(Error::input(source, format!("`@{count}`: the target triangle count must be a positive integer"))),
     }
 }
 
