@@ -226,7 +226,10 @@ fn gpu_backend_without_a_driver_says_how_to_get_one() {
     // The closing summary counts it and says why.
     let out = stdout(&o);
     assert!(!out.contains("wrote"), "wrote something: {out}");
-    assert!(out.contains("reproduced 0 of 1 specs") && out.contains("skipped hw-vertex-reuse: it needs a GPU"), "{out}");
+    assert!(
+        out.contains("reproduced 0 of 1 specs") && out.contains("skipped hw-vertex-reuse: it needs a GPU"),
+        "{out}"
+    );
 }
 
 #[test]
