@@ -91,7 +91,7 @@ fn every_method_copes_with_awkward_meshes() {
 /// Real, irregular meshes: one closed, one with non-manifold edges from decimation, one
 /// quad-dominant with seams.
 #[test]
-#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (see README, Data)")]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
 fn every_method_gives_well_formed_orders_on_real_meshes() {
     for name in ["bunny_2k.ply", "dragon_vrip_res4.ply", "pirate.obj"] {
         check_every_method(&common::real_mesh(name));
