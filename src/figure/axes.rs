@@ -116,13 +116,17 @@ where
 }
 
 /// Colours chosen so that a series keeps its colour from figure to figure, by its name alone:
-/// each family (a method's name without its parameters, or any other series value) prefers the
-/// palette slot its name hashes to; variants of one method (a parameter grid) are lighter and
+/// the two reference orders have their own (`input` grey, `random` red), and every other family
+/// (a method's name without its parameters, or any other series value) prefers the palette slot
+/// its name hashes to among the rest; variants of one method (a parameter grid) are lighter and
 /// darker shades of it. Two families of one figure never share a slot while the palette lasts:
 /// where their preferred slots collide, the family first in alphabetical order keeps its slot
 /// and the other takes the next free one. So adding a method to the registry changes no figure
 /// it is not in, and a figure's colours do not depend on its legend order.
 pub struct Colors(Vec<(String, RGBColor)>);
+
+/// Methods with a palette slot of their own, in slot order: the file's order and the worst case.
+const RESERVED: [&str; 2] = ["input", "random"];
 
 const PALETTE: [RGBColor; 20] = [
     RGBColor(0x4d, 0x4d, 0x4d), // grey
@@ -155,13 +159,16 @@ impl Colors {
         let mut families: Vec<String> = names.iter().map(|n| family(n)).collect();
         families.sort();
         families.dedup();
-        let mut slots: Vec<(String, usize)> = Vec::new();
-        for key in families {
-            let mut slot = fnv1a(&key) % PALETTE.len();
+        let reserved = |key: &str| if methods { RESERVED.iter().position(|&r| r == key) } else { None };
+        let mut slots: Vec<(String, usize)> =
+            families.iter().filter_map(|key| Some((key.clone(), reserved(key)?))).collect();
+        let free = PALETTE.len() - RESERVED.len();
+        for key in families.iter().filter(|key| reserved(key).is_none()) {
+            let mut slot = RESERVED.len() + fnv1a(key) % free;
             while slots.len() < PALETTE.len() && slots.iter().any(|&(_, s)| s == slot) {
-                slot = (slot + 1) % PALETTE.len();
+                slot = RESERVED.len() + (slot + 1 - RESERVED.len()) % free;
             }
-            slots.push((key, slot));
+            slots.push((key.clone(), slot));
         }
         let colors = names
             .iter()
@@ -337,6 +344,8 @@ mod tests {
         let names: Vec<String> =
             ["input", "random:seed=0", "meshopt-fifo:cache=8", "meshopt-fifo:cache=16"].map(String::from).to_vec();
         let colors = Colors::new("method", &names);
+        assert_eq!(colors.of("input"), PALETTE[0]);
+        assert_eq!(colors.of("random:seed=0"), PALETTE[1]);
         assert_ne!(colors.of("meshopt-fifo:cache=8"), colors.of("meshopt-fifo:cache=16"));
         let distinct: std::collections::HashSet<_> = names.iter().map(|n| format!("{:?}", colors.of(n))).collect();
         assert_eq!(distinct.len(), names.len());
