@@ -100,6 +100,7 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
         }
     }
     let kind = chart.figure.kind;
+    let acmrs = table.rows("acmr", &["model", "method", "cache"])?;
     let mut drawings = Vec::new();
     for row in &saved {
         let (model, method) = (row.model.as_str(), row.method.as_str());
@@ -113,7 +114,6 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
             return Err(stale(format!("the clusters of `{method}` on `{model}` do not tile its order")));
         }
         let triangles = mesh.triangles_in_order(&order);
-        let acmrs = table.rows("acmr", &["model", "method", "cache"])?;
         let recorded: Vec<(&str, f64)> =
             acmrs.iter().filter(|(c, _)| c[0] == model && c[1] == method).map(|(c, v)| (c[2].as_str(), *v)).collect();
         let name = method.split(':').next().unwrap_or(method);
