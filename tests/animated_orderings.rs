@@ -47,7 +47,7 @@ fn procedural(spec: &str) -> Mesh {
 }
 
 /// The method's own output, not passed through `order::run`'s checks.
-fn order_nodes(spec: &str, scene: &Scene) -> Orders {
+fn orders_of(spec: &str, scene: &Scene) -> Orders {
     let resolved = order::resolve(spec, 0).unwrap_or_else(|e| panic!("{spec}: {e}"));
     resolved.ordering.order(scene).unwrap_or_else(|e| panic!("{spec}: {e}"))
 }
@@ -79,7 +79,7 @@ fn every_buffer_is_a_permutation_and_every_cell_names_one() {
     for (file, frames) in [("RiggedSimple.glb", 3), ("RiggedFigure.glb", 3), ("Fox.glb", 2)] {
         let scene = animation(file, None, frames);
         for spec in ["hs17:views=12,res=32", "hs17:views=12,res=32,mode=joint,clusters=3", "tipsify-per-frame"] {
-            let nodes = order_nodes(spec, &scene);
+            let nodes = orders_of(spec, &scene);
             assert_well_formed(&format!("{file} {spec}"), &scene, &nodes);
             // The checked entry point accepts what the method returned, unchanged.
             let resolved = order::resolve(spec, 0).unwrap();
@@ -87,7 +87,7 @@ fn every_buffer_is_a_permutation_and_every_cell_names_one() {
             assert_eq!((checked.buffers, checked.lookup), (nodes.buffers, nodes.lookup), "{file} {spec}");
         }
         // One buffer per keyframe, drawn from every direction of that keyframe only.
-        let per_frame = order_nodes("tipsify-per-frame", &scene);
+        let per_frame = orders_of("tipsify-per-frame", &scene);
         assert_eq!(per_frame.buffers.len(), scene.frames.len(), "{file}");
         for f in 0..scene.frames.len() {
             assert_eq!(buffers_used(&per_frame.lookup, f..f + 1), BTreeSet::from([f as u16]), "{file} frame {f}");
@@ -104,7 +104,7 @@ fn single_mode_keeps_clips_apart_and_joint_mode_shares_k_buffers() {
     let clips = &scene.frames.clips;
     assert!(clips.len() >= 2, "Fox has several clips: {clips:?}");
     let k = 3;
-    let single = order_nodes(&format!("hs17:views=12,res=32,clusters={k}"), &scene);
+    let single = orders_of(&format!("hs17:views=12,res=32,clusters={k}"), &scene);
     let per_clip: Vec<BTreeSet<u16>> = clips.iter().map(|(_, r)| buffers_used(&single.lookup, r.clone())).collect();
     for (i, (name, _)) in clips.iter().enumerate() {
         assert!(!per_clip[i].is_empty() && per_clip[i].len() <= k, "{name}: {:?}", per_clip[i]);
@@ -114,7 +114,7 @@ fn single_mode_keeps_clips_apart_and_joint_mode_shares_k_buffers() {
     }
     assert_eq!(per_clip.iter().map(BTreeSet::len).sum::<usize>(), single.buffers.len());
 
-    let joint = order_nodes(&format!("hs17:views=12,res=32,clusters={k},mode=joint"), &scene);
+    let joint = orders_of(&format!("hs17:views=12,res=32,clusters={k},mode=joint"), &scene);
     assert!(joint.buffers.len() <= k, "joint mode made {} buffers for k = {k}", joint.buffers.len());
     assert_well_formed("joint", &scene, &joint);
 }
@@ -124,7 +124,7 @@ fn single_mode_keeps_clips_apart_and_joint_mode_shares_k_buffers() {
 fn same_seed_same_buffers_and_lookup() {
     let scene = animation("Fox.glb", Some("Walk"), 3);
     for spec in ["hs17:views=12,res=32,seed=7", "hs17:views=42,res=32,seed=7,mode=joint", "tipsify-per-frame"] {
-        let (a, b) = (order_nodes(spec, &scene), order_nodes(spec, &scene));
+        let (a, b) = (orders_of(spec, &scene), orders_of(spec, &scene));
         assert!(a.buffers == b.buffers, "{spec}: buffers differ between runs");
         assert_eq!(a.lookup, b.lookup, "{spec}");
         assert_eq!((a.iterations, a.converged), (b.iterations, b.converged), "{spec}");
@@ -133,7 +133,7 @@ fn same_seed_same_buffers_and_lookup() {
     // writing it out.
     let resolved = order::resolve("hs17:views=12,res=32", 7).unwrap();
     let implicit = resolved.ordering.order(&scene).unwrap();
-    let explicit = order_nodes("hs17:views=12,res=32,seed=7", &scene);
+    let explicit = orders_of("hs17:views=12,res=32,seed=7", &scene);
     assert!(implicit.buffers == explicit.buffers && implicit.lookup == explicit.lookup);
 }
 
@@ -146,28 +146,28 @@ fn same_seed_same_buffers_and_lookup() {
 fn kmeans_reports_its_rounds_and_whether_it_converged() {
     let scene = animation("RiggedFigure.glb", None, 3);
     let base = "hs17:views=42,res=32,clusters=5,seed=1";
-    let free = order_nodes(base, &scene);
+    let free = orders_of(base, &scene);
     let Some(n) = free.iterations else { panic!("hs17 reports its rounds") };
     eprintln!("RiggedFigure {base}: {n} rounds, converged {}", free.converged);
     assert!(free.converged, "did not converge in the default cap of rounds ({n})");
     assert!(n >= 2, "convergence takes a confirming round: {n}");
 
-    let once = order_nodes(&format!("{base},iterations=1"), &scene);
+    let once = orders_of(&format!("{base},iterations=1"), &scene);
     assert_eq!((once.iterations, once.converged), (Some(1), false));
     assert_well_formed("iterations=1", &scene, &once);
 
-    let exact = order_nodes(&format!("{base},iterations={n}"), &scene);
+    let exact = orders_of(&format!("{base},iterations={n}"), &scene);
     assert_eq!((exact.iterations, exact.converged), (Some(n), true), "capped at the round it converges in");
     assert!(exact.buffers == free.buffers && exact.lookup == free.lookup);
     if n > 2 {
-        let short = order_nodes(&format!("{base},iterations={}", n - 1), &scene);
+        let short = orders_of(&format!("{base},iterations={}", n - 1), &scene);
         assert_eq!((short.iterations, short.converged), (Some(n - 1), false));
         assert_well_formed("capped short", &scene, &short);
     }
 
-    let one = order_nodes("hs17:views=12,res=32,clusters=1", &scene);
+    let one = orders_of("hs17:views=12,res=32,clusters=1", &scene);
     assert_eq!((one.iterations, one.converged), (Some(2), true));
-    let capped = order_nodes("hs17:views=12,res=32,clusters=1,iterations=2", &scene);
+    let capped = orders_of("hs17:views=12,res=32,clusters=1,iterations=2", &scene);
     assert_eq!((capped.iterations, capped.converged), (Some(2), true));
 }
 
@@ -191,10 +191,10 @@ fn static_mesh_gets_view_clustered_buffers() {
     for (name, mesh) in meshes {
         let scene = still(mesh);
         assert_eq!(scene.frames.len(), 1);
-        let one = order_nodes("hs17:views=42,res=64,clusters=1", &scene);
+        let one = orders_of("hs17:views=42,res=64,clusters=1", &scene);
         assert_eq!(one.buffers.len(), 1, "{name}");
         assert!(one.lookup.cells().iter().all(|&b| b == 0), "{name}");
-        let five = order_nodes("hs17:views=42,res=64,clusters=5", &scene);
+        let five = orders_of("hs17:views=42,res=64,clusters=5", &scene);
         assert_well_formed(&name, &scene, &five);
         assert!(five.buffers.len() > 1, "{name}: one frame, yet the views did not split");
         for seed in [0, 1] {
@@ -213,7 +213,7 @@ fn tipsify_per_frame_is_sander07_on_each_posed_frame() {
     for (file, frames) in [("RiggedFigure.glb", 3), ("Fox.glb", 2)] {
         let scene = animation(file, None, frames);
         for params in ["", ":cache=12,lambda=0.6"] {
-            let nodes = order_nodes(&format!("tipsify-per-frame{params}"), &scene);
+            let nodes = orders_of(&format!("tipsify-per-frame{params}"), &scene);
             let sander07 = order::resolve(&format!("sander07{params}"), 0).unwrap();
             assert_eq!(nodes.buffers.len(), scene.frames.len());
             let mut distinct = BTreeSet::new();
