@@ -12,7 +12,7 @@
 //! this when one of these variables changes; after fetching the models into a new directory, set
 //! `TRIORDER_DATA` to it.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(triorder_data)");
@@ -26,7 +26,11 @@ fn main() {
     let data = std::env::var_os("TRIORDER_DATA")
         .filter(|d| !d.is_empty())
         .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+        .unwrap_or_else(|| {
+            // Read when the script runs (Cargo sets it then), not baked in when it was compiled.
+            let root = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_default();
+            root.join("../shared/data")
+        });
     if set("TRIORDER_REQUIRE_DATA") || data.is_dir() {
         println!("cargo::rustc-cfg=triorder_data");
     }
