@@ -139,16 +139,16 @@ fn save_into_a_read_only_directory_fails_and_leaves_nothing() {
     let locked = dir.path().join("locked");
     std::fs::create_dir(&locked).unwrap();
     std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).unwrap();
-    // Root ignores directory permissions: then there is nothing to test.
-    if std::fs::write(locked.join("probe"), b"").is_ok() {
-        eprintln!("notice: {} is writable despite mode 0555 (running as root?); skipping", locked.display());
-        return;
-    }
-    let path = locked.join("out.obj");
+    // Root ignores directory permissions; /proc refuses new files even to root.
+    let root = std::fs::write(locked.join("probe"), b"").is_ok();
+    let _ = std::fs::remove_file(locked.join("probe"));
+    let target = if root { std::path::Path::new("/proc").to_path_buf() } else { locked.clone() };
+    let path = target.join("triorder-out.obj");
     let result = save(&triangle(), &path);
     std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o755)).unwrap();
     let message = result.unwrap_err().to_string();
     assert!(message.contains(&path.display().to_string()), "{message}");
+    assert!(!path.exists());
     assert!(listing(&locked).is_empty());
 }
 
