@@ -23,14 +23,11 @@ fn main() {
         println!("cargo::rerun-if-env-changed={var}");
     }
     let set = |var: &str| std::env::var_os(var).is_some_and(|v| !v.is_empty());
-    let data = std::env::var_os("TRIORDER_DATA")
-        .filter(|d| !d.is_empty())
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            // Read when the script runs (Cargo sets it then), not baked in when it was compiled.
-            let root = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_default();
-            root.join("../shared/data")
-        });
+    let data = std::env::var_os("TRIORDER_DATA").filter(|d| !d.is_empty()).map(PathBuf::from).unwrap_or_else(|| {
+        // Read when the script runs (Cargo sets it then), not baked in when it was compiled.
+        let root = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_default();
+        root.join("../shared/data")
+    });
     if set("TRIORDER_REQUIRE_DATA") || data.is_dir() {
         println!("cargo::rustc-cfg=triorder_data");
     }

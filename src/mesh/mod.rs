@@ -14,6 +14,7 @@ pub mod load;
 pub mod obj;
 pub mod ply;
 pub mod procedural;
+pub mod progressive;
 pub mod report;
 pub mod save;
 pub mod scene;

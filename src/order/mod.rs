@@ -11,6 +11,7 @@
 //! (method specs); families that share helpers have a folder: `curves/` (snake, Hilbert),
 //! `meshopt/` (the peers), `mla/` and `nehab/` (their helpers beside them).
 
+pub mod levels;
 pub mod orders;
 pub mod params;
 
