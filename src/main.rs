@@ -67,6 +67,19 @@ struct Measure {
     backend: String,
 }
 
+/// Progressive levels to measure, for `eval` on a static mesh.
+#[derive(Args, Clone, Default)]
+struct Progressive {
+    /// Simplify the mesh by vertex removals (least quadric error first) and measure it at each
+    /// of these fractions of its triangles, e.g. 1,0.5,0.25,0.1 (Bogomjakov & Gotsman 2002, §3).
+    #[arg(long, value_name = "F,F,...", value_delimiter = ',')]
+    levels: Vec<f64>,
+    /// How the method's sequence follows the levels: smart or simple (the paper's updates, from
+    /// the full mesh's sequence), or reorder (the method run anew on each level).
+    #[arg(long, default_value = "smart", value_name = "smart|simple|reorder")]
+    update: String,
+}
+
 /// Which animation to measure, for `eval` on a skinned glTF/GLB file.
 #[derive(Args, Clone, Default)]
 struct Animation {
@@ -122,7 +135,8 @@ enum Command {
     ///
     /// With --clip (or --frames, --subdiv) the mesh is a skinned glTF/GLB animation; so it is
     /// when the mesh is written PATH#clip=NAME,frames=N,subdiv=L. Keyframe- and view-dependent
-    /// methods (hs17, tipsify-per-frame) give several index buffers, counted in `buffers`.
+    /// methods (hs17, tipsify-per-frame) give several index buffers, counted in `buffers`. With
+    /// --levels every method is measured at each level of a progressive mesh.
     Eval {
         /// Mesh file or procedural spec.
         mesh: String,
@@ -133,6 +147,8 @@ enum Command {
         measure: Measure,
         #[command(flatten)]
         animation: Animation,
+        #[command(flatten)]
+        progressive: Progressive,
         /// One JSON object per method per line instead of a table.
         #[arg(long)]
         json: bool,
@@ -190,8 +206,8 @@ fn main() -> ExitCode {
         Command::Order { input, output, method, remap_vertices, measure } => {
             commands::order(&input, &output, &method, remap_vertices, &measure, common)
         }
-        Command::Eval { mesh, methods, measure, animation, json } => {
-            commands::eval(&mesh, &methods, &measure, &animation, json, common)
+        Command::Eval { mesh, methods, measure, animation, progressive, json } => {
+            commands::eval(&mesh, &methods, &measure, &animation, &progressive, json, common)
         }
         Command::Run { spec, quick, backend } => commands::run(&spec, quick, backend, common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick, common),

@@ -11,13 +11,14 @@ use std::path::Path;
 use triorder::gpu::render_time::{MAX_FRAMES, Shading};
 use triorder::measure::{self, CacheModel, MeasureOptions};
 use triorder::mesh::gltf::animation::ClipSelection;
+use triorder::mesh::progressive::Update;
 use triorder::mesh::source::{self, AnimationSource};
 use triorder::mesh::{Scene, Source};
 use triorder::order::{self, METHODS, Orders, params::describe_kind};
 use triorder::raster::{RasterBackend, ViewSet};
 use triorder::{Error, Result};
 
-use crate::{Animation, Common, Measure};
+use crate::{Animation, Common, Measure, Progressive};
 
 /// Parsed measurement options plus the chosen backend.
 struct Measuring {
@@ -54,7 +55,7 @@ fn open(source: &Source, common: &Common) -> Result<Scene> {
     let data = source::data_dir(common.data.as_deref());
     let scene = source.open(data.as_deref(), common.seed)?;
     let mut line = format!("{source}: {}", scene.report());
-    if scene.frames.animated {
+    if scene.frames.is_animation() {
         let clips: Vec<String> = scene.frames.clips.iter().map(|(n, r)| format!("{n} ({} frames)", r.len())).collect();
         line = format!("{line}; clips: {}", clips.join(", "));
     }
@@ -85,6 +86,7 @@ pub fn eval(
     methods: &[String],
     measure: &Measure,
     animation: &Animation,
+    progressive: &Progressive,
     json: bool,
     common: &Common,
 ) -> Result<()> {
@@ -93,15 +95,21 @@ pub fn eval(
         if methods.is_empty() { vec!["input"] } else { methods.iter().map(String::as_str).collect() };
     let resolved = specs.iter().map(|s| order::resolve(s, common.seed)).collect::<Result<Vec<_>>>()?;
     let source = with_animation(Source::parse(source)?, animation)?;
-    let scene = open(&source, common)?;
-    let buffers = scene.frames.animated || resolved.iter().any(|r| r.method.per_node);
+    let update = Update::parse(&progressive.update)?;
+    let mut scene = open(&source, common)?;
+    if !progressive.levels.is_empty() {
+        scene = scene.with_levels(&progressive.levels, update)?;
+    }
+    let buffers = scene.frames.is_animation() || resolved.iter().any(|r| r.method.per_node);
     let mut table = tables::EvalTable::new(buffers);
     for method in &resolved {
         let e = measure::evaluate(&scene, method, &measuring.options, measuring.raster.as_ref())?;
         if json {
-            println!("{}", tables::eval_json(&scene, &e, &measuring.raster.describe()));
+            for line in tables::eval_json(&scene, &e, &measuring.raster.describe()) {
+                println!("{line}");
+            }
         } else {
-            table.push(&e);
+            table.push(&scene, &e);
         }
     }
     if !json {

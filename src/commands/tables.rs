@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 use triorder::measure::{Evaluation, Measured, Value};
+use triorder::mesh::frames::Kind;
 use triorder::mesh::{Mesh, Scene};
 
 /// `eval`'s readable table: one row per method, the columns its metrics show.
@@ -20,13 +21,21 @@ impl EvalTable {
         EvalTable { buffers, rows: Vec::new() }
     }
 
-    pub fn push(&mut self, e: &Evaluation) {
-        let mut row = vec![("method".to_string(), e.method.clone()), ("seconds".into(), format!("{:.4}", e.seconds))];
-        if self.buffers {
-            row.push(("buffers".into(), e.orders.buffers.len().to_string()));
+    /// The row of `e`, or on a progressive mesh one row per level.
+    pub fn push(&mut self, scene: &Scene, e: &Evaluation) {
+        for (level, fraction, triangles) in levels(scene) {
+            let mut row = vec![("method".to_string(), e.method.clone())];
+            if let Some(fraction) = fraction {
+                row.push(("level".into(), format!("{fraction}")));
+                row.push(("triangles".into(), triangles.to_string()));
+            }
+            row.push(("seconds".into(), format!("{:.4}", e.seconds)));
+            if self.buffers {
+                row.push(("buffers".into(), e.orders.buffers.len().to_string()));
+            }
+            row.extend(e.measured.iter().flat_map(|m| m.at_level(level).columns()));
+            self.rows.push(row);
         }
-        row.extend(e.measured.iter().flat_map(Measured::columns));
-        self.rows.push(row);
     }
 
     pub fn render(&self, mesh: &Mesh) -> String {
@@ -55,7 +64,8 @@ impl EvalTable {
     }
 }
 
-/// One `eval --json` line: the evaluation, then every value under its metric's name. Summary
+/// One `eval --json` line (one per level for a progressive mesh): the evaluation, then every
+/// value under its metric's name. Summary
 /// values (all frames, no single view and no cache) are top-level fields, as DESIGN.md promises
 /// for `ovr_mean` and `ovr_max`; the first cache's `acmr` and `atvr` are too. Values per cache
 /// model are grouped under `caches`, per clip under `clips`, and per view under `per_view` (one
@@ -65,6 +75,11 @@ struct EvalLine<'a> {
     mesh: &'a str,
     method: &'a str,
     peer: bool,
+    /// For a progressive mesh: the fraction of the triangles this level asked for, and the update.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    level: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    update: Option<&'static str>,
     triangles: usize,
     vertices: usize,
     frames: usize,
@@ -103,14 +118,52 @@ struct Group<'a> {
     values: BTreeMap<&'static str, f64>,
 }
 
-pub fn eval_json(scene: &Scene, e: &Evaluation, backend: &str) -> String {
+pub fn eval_json(scene: &Scene, e: &Evaluation, backend: &str) -> Vec<String> {
+    levels(scene)
+        .into_iter()
+        .map(|(level, fraction, triangles)| json_line(scene, e, backend, level, fraction, triangles))
+        .collect()
+}
+
+/// The level index, fraction and triangle count of each level of `scene`, or one entry of `None`s
+/// (and the mesh's count) for a scene without levels.
+fn levels(scene: &Scene) -> Vec<(Option<usize>, Option<f64>, usize)> {
+    match &scene.frames.kind {
+        Kind::Levels(levels) => {
+            (0..levels.alive.len()).map(|f| (Some(f), Some(levels.fractions[f]), levels.alive[f].len())).collect()
+        }
+        _ => vec![(None, None, scene.mesh.triangle_count())],
+    }
+}
+
+/// One `--json` line: the evaluation, or one level of it.
+fn json_line(
+    scene: &Scene,
+    e: &Evaluation,
+    backend: &str,
+    level: Option<usize>,
+    fraction: Option<f64>,
+    triangles: usize,
+) -> String {
     let mesh = &scene.mesh;
+    let update = match &scene.frames.kind {
+        Kind::Levels(levels) => Some(levels.update.name()),
+        _ => None,
+    };
+    let vertices = match &scene.frames.kind {
+        Kind::Levels(levels) => {
+            triorder::measure::cache::referenced(&levels.triangles(level.unwrap_or(0)), mesh.vertex_count())
+        }
+        _ => mesh.vertex_count(),
+    };
     let mut line = EvalLine {
         mesh: &mesh.name,
         method: &e.method,
         peer: e.peer,
-        triangles: mesh.triangle_count(),
-        vertices: mesh.vertex_count(),
+        level: fraction,
+        update,
+        triangles,
+        vertices,
         frames: scene.frames.len(),
         seconds: e.seconds,
         buffers: e.orders.buffers.len(),
@@ -127,7 +180,7 @@ pub fn eval_json(scene: &Scene, e: &Evaluation, backend: &str) -> String {
         clips: Vec::new(),
         per_view: BTreeMap::new(),
     };
-    for v in e.values() {
+    for v in e.values().filter(|v| v.level == level) {
         if let Some((views, res)) = v.views {
             line.views = Some(views.to_string());
             line.res = Some(res);

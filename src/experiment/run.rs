@@ -74,26 +74,36 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
     // animation, and for every model when some method gives several buffers.
     let per_node = methods.iter().any(|m| m.method.per_node);
 
-    let bar = bars.add(ProgressBar::new((work.models.len() * methods.len()) as u64));
+    let updates = if work.levels.is_empty() { 1 } else { spec.updates.len() };
+    let bar = bars.add(ProgressBar::new((work.models.len() * methods.len() * updates) as u64));
     bar.set_style(style("{prefix} {pos}/{len} {bar:30} {elapsed} {wide_msg}"));
     bar.set_prefix(spec.id.clone());
     let mut rows: Vec<Row> = Vec::new();
     let mut orders: Vec<OrderRow> = Vec::new();
     for model in &work.models {
         bar.set_message(format!("{}: loading", model.name));
-        let scene = model.source.open(data.as_deref(), spec.seed)?;
+        let mut scene = model.source.open(data.as_deref(), spec.seed)?;
         for warning in scene.report().warnings() {
             bars.suspend(|| eprintln!("{}: note: {warning}", model.name));
         }
-        for method in &methods {
-            bar.set_message(format!("{} · {}", model.name, method.canonical()));
-            let evaluation = measure::evaluate(&scene, method, &options, raster.as_ref())?;
-            let buffers = per_node || scene.frames.animated;
-            rows.extend(context.rows(&model.name, &model.source, &scene, &evaluation, buffers));
-            if spec.figure.kind.draws_meshes() {
-                orders.push(drawn(spec, &model.name, &scene, &evaluation, &options.caches)?);
+        if !work.levels.is_empty() {
+            bar.set_message(format!("{}: simplifying", model.name));
+            scene = scene.with_levels(&work.levels, spec.updates[0])?;
+        }
+        // Without levels the one update is never used.
+        let updates = if work.levels.is_empty() { &spec.updates[..1] } else { &spec.updates[..] };
+        for &update in updates {
+            scene.set_update(update);
+            for method in &methods {
+                bar.set_message(format!("{} · {}", model.name, method.canonical()));
+                let evaluation = measure::evaluate(&scene, method, &options, raster.as_ref())?;
+                let buffers = per_node || scene.frames.is_animation();
+                rows.extend(context.rows(&model.name, &model.source, &scene, &evaluation, buffers));
+                if spec.figure.kind.draws_meshes() {
+                    orders.push(drawn(spec, &model.name, &scene, &evaluation, &options.caches)?);
+                }
+                bar.inc(1);
             }
-            bar.inc(1);
         }
     }
     bar.finish_and_clear();

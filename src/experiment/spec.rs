@@ -35,6 +35,11 @@
 //! render = ["pixel", "vertex"]     # optional, with views: time rendering on the GPU from every
 //!                                  # view with a pixel-bound and/or a vertex-bound shader
 //! render_frames = 30               # optional: timed frames per view and shader (default 30)
+//! levels = [1.0, 0.5, 0.25]        # optional: measure each static model as a progressive mesh
+//!                                  # at these fractions of its triangles (rows name `level`)
+//! updates = ["simple", "smart"]    # optional, with levels: how each method's sequence follows
+//!                                  # the levels: simple, smart (default) or reorder (rows name
+//!                                  # `update`)
 //!
 //! [figure]
 //! kind = "line"                    # line | scatter | bar | distribution | table |
@@ -89,6 +94,7 @@ use crate::figure::{Chart, PlotOptions};
 use crate::gpu::render_time::{MAX_FRAMES, Shading};
 use crate::measure::{self, CacheModel, GPU_CACHE, MeasureOptions};
 use crate::mesh::Source;
+use crate::mesh::progressive::Update;
 use crate::order::{self, METHODS};
 use crate::raster::ViewSet;
 
@@ -121,6 +127,8 @@ pub struct Spec {
     /// Canonical method specs (every parameter written out), grids expanded, duplicates
     /// removed, in the order the spec lists them.
     pub methods: Vec<String>,
+    /// With levels: how each method's sequence follows them (default smart).
+    pub updates: Vec<Update>,
     /// What a full run measures.
     pub full: Workload,
     /// What `--quick` measures, if the spec has a `[quick]` table.
@@ -146,6 +154,9 @@ pub struct Workload {
     pub res: u32,
     /// Timed frames per view and shader when the spec renders.
     pub render_frames: usize,
+    /// Progressive levels, as fractions of each model's triangles, most first; empty: the models
+    /// as they are.
+    pub levels: Vec<f64>,
 }
 
 impl Spec {
@@ -241,6 +252,9 @@ struct RawSpec {
     #[serde(default)]
     render: Vec<String>,
     render_frames: Option<usize>,
+    levels: Option<Vec<f64>>,
+    #[serde(default)]
+    updates: Vec<String>,
     figure: RawFigure,
     quick: Option<RawQuick>,
 }
@@ -284,6 +298,7 @@ struct RawQuick {
     views: Option<String>,
     res: Option<u32>,
     render_frames: Option<usize>,
+    levels: Option<Vec<f64>>,
 }
 
 impl RawSpec {
@@ -305,12 +320,31 @@ impl RawSpec {
             }
         }
         let methods = check_methods(&self.methods, self.seed).map_err(err)?;
+        let updates = match (self.levels.is_some(), self.updates.is_empty()) {
+            (false, false) => return Err(err("updates is set but levels is not".into())),
+            (_, true) => vec![Update::Smart],
+            (true, false) => self
+                .updates
+                .iter()
+                .map(|u| Update::parse(u))
+                .collect::<Result<Vec<_>>>()
+                .map_err(|e| err(format!("updates: {e}")))?,
+        };
+        if self.levels.is_some()
+            && let Some(m) = methods.iter().find(|m| order::resolve(m, self.seed).is_ok_and(|r| r.method.per_node))
+        {
+            return Err(err(format!(
+                "levels keep one sequence per model, but method `{m}` gives an index buffer per (keyframe, view)"
+            )));
+        }
         let backend = self.backend.unwrap_or_else(|| "cpu".into());
         crate::measure::check_backend_name(&backend).map_err(|e| err(format!("backend: {e}")))?;
 
         let render_frames = self.render_frames.unwrap_or(DEFAULT_RENDER_FRAMES);
-        let full = check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res, render_frames)
-            .map_err(err)?;
+        let levels = self.levels.clone().unwrap_or_default();
+        let full =
+            check_workload("", &self.models, &self.caches, self.views.as_deref(), self.res, render_frames, &levels)
+                .map_err(err)?;
         let quick = match &self.quick {
             None => None,
             Some(q) => {
@@ -318,7 +352,9 @@ impl RawSpec {
                 let views = q.views.as_deref().or(self.views.as_deref());
                 let res = q.res.or(self.res);
                 let frames = q.render_frames.unwrap_or(render_frames);
-                let work = check_workload("quick.", &q.models, caches, views, res, frames).map_err(err)?;
+                let quick_levels = q.levels.as_ref().unwrap_or(&levels);
+                let work =
+                    check_workload("quick.", &q.models, caches, views, res, frames, quick_levels).map_err(err)?;
                 if let Some((i, model)) = work.models.iter().enumerate().find(|(_, m)| !m.source.is_bundled()) {
                     return Err(err(format!(
                         "quick.models[{i}] `{}`: quick runs use procedural models and files under assets/ only, so they work on a fresh clone",
@@ -378,6 +414,7 @@ impl RawSpec {
             backend,
             render,
             methods,
+            updates,
             full,
             quick,
             figure,
@@ -426,6 +463,7 @@ fn check_workload(
     views: Option<&str>,
     res: Option<u32>,
     render_frames: usize,
+    levels: &[f64],
 ) -> std::result::Result<Workload, String> {
     if models.is_empty() {
         return Err(format!("{prefix}models is empty"));
@@ -469,7 +507,18 @@ fn check_workload(
     if !(1..=MAX_FRAMES).contains(&render_frames) {
         return Err(format!("{prefix}render_frames = {render_frames} is not in 1..={MAX_FRAMES}"));
     }
-    Ok(Workload { models, caches: parsed, gpu_vertices, views, res, render_frames })
+    if let Some(bad) = levels.iter().find(|f| !(**f > 0.0 && **f <= 1.0)) {
+        return Err(format!("{prefix}levels: {bad} is not a fraction of the triangles in (0, 1]"));
+    }
+    if !levels.is_empty()
+        && let Some(model) = models.iter().find(|m| m.source.is_animation())
+    {
+        return Err(format!("{prefix}levels are for static meshes, but `{}` is an animation", model.name));
+    }
+    let mut levels = levels.to_vec();
+    levels.sort_by(|a, b| b.total_cmp(a));
+    levels.dedup();
+    Ok(Workload { models, caches: parsed, gpu_vertices, views, res, render_frames, levels })
 }
 
 /// Expands a cache spec: `KIND:LO..HI[/STEP]` is shorthand for `KIND:{LO..HI[/STEP]}`; any

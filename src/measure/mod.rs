@@ -21,6 +21,7 @@
 //! and specs do not have yet (views, caches, render shadings and the GPU switch exist) adds it to
 //! [`MeasureOptions`] too.
 
+use std::ops::Range;
 use std::time::Instant;
 
 pub use cache::{CacheModel, CacheStats, Corner};
@@ -29,6 +30,7 @@ pub use overdraw::OverdrawSummary;
 use crate::error::{Error, Result};
 use crate::gpu::render_time::Shading;
 use crate::mesh::Scene;
+use crate::mesh::frames::Kind;
 use crate::order::{self, Orders, Resolved};
 use crate::raster::{Camera, RasterBackend, ViewSet};
 
@@ -159,6 +161,8 @@ pub struct Value {
     pub view: Option<usize>,
     /// The clip of an animation the value is about; `None` for all frames.
     pub clip: Option<String>,
+    /// The level of a progressive mesh the value is about (a frame index).
+    pub level: Option<usize>,
     /// The GPU that counted or timed it.
     pub device: Option<String>,
     pub value: f64,
@@ -166,10 +170,11 @@ pub struct Value {
 
 impl Value {
     pub fn new(metric: &'static str, value: f64) -> Value {
-        Value { metric, cache: None, views: None, view: None, clip: None, device: None, value }
+        Value { metric, cache: None, views: None, view: None, clip: None, level: None, device: None, value }
     }
 
-    /// A value of all frames and no single view: what tables and summaries show.
+    /// A value of all frames (or one whole level) and no single view: what tables and summaries
+    /// show.
     pub fn is_summary(&self) -> bool {
         self.view.is_none() && self.clip.is_none()
     }
@@ -187,20 +192,25 @@ impl Value {
     }
 }
 
-/// What one evaluation draws: every frame of the scene from every camera of the view set, each
-/// draw with the buffer the method's lookup picks for its frame and direction.
+/// What one evaluation draws: every frame of `frames` (all of the scene's, or one level of a
+/// progressive mesh) from every camera of the view set, each draw with the buffer the method's
+/// lookup picks for its frame and direction.
 pub struct Draws<'a> {
     pub scene: &'a Scene,
     pub orders: &'a Orders,
     pub options: &'a MeasureOptions,
     pub raster: &'a dyn RasterBackend,
+    /// The frames drawn.
+    pub frames: Range<usize>,
     /// The view set's cameras, framed for the scene; empty without a view set.
     pub cameras: Vec<Camera>,
-    /// Per frame, per camera (frame-major): the buffer drawn.
+    /// Per frame of `frames`, per camera (frame-major): the buffer drawn.
     picks: Vec<usize>,
     /// How many draws use each buffer. Without a view set there are no draws, and each buffer
-    /// counts as often as lookup cells pick it.
+    /// counts as often as lookup cells of `frames` pick it.
     pub uses: Vec<u64>,
+    /// Per buffer, a frame that draws it: whose triangles it orders.
+    frame_of: Vec<usize>,
 }
 
 impl<'a> Draws<'a> {
@@ -209,23 +219,34 @@ impl<'a> Draws<'a> {
         orders: &'a Orders,
         options: &'a MeasureOptions,
         raster: &'a dyn RasterBackend,
+        frames: Range<usize>,
     ) -> Draws<'a> {
         let framing = scene.frames.framing;
         let cameras = options.views.map_or_else(Vec::new, |views| views.cameras(framing, options.seed));
+        let lookup = &orders.lookup;
         let mut uses = vec![0u64; orders.buffers.len()];
-        let mut picks = Vec::with_capacity(scene.frames.len() * cameras.len());
-        if cameras.is_empty() {
-            orders.lookup.cells().iter().for_each(|&b| uses[usize::from(b)] += 1);
-        } else {
-            for f in 0..scene.frames.len() {
+        let mut frame_of = vec![frames.start; orders.buffers.len()];
+        let mut picks = Vec::with_capacity(frames.len() * cameras.len());
+        let mut pick = |f: usize, b: usize, uses: &mut Vec<u64>| {
+            if uses[b] == 0 {
+                frame_of[b] = f;
+            }
+            uses[b] += 1;
+        };
+        for f in frames.clone() {
+            if cameras.is_empty() {
+                let cells = lookup.cells_per_frame();
+                let row = f.min(lookup.frames() - 1) * cells;
+                lookup.cells()[row..row + cells].iter().for_each(|&b| pick(f, usize::from(b), &mut uses));
+            } else {
                 for camera in &cameras {
-                    let b = orders.lookup.buffer(f, camera.eye - framing.center);
-                    uses[b] += 1;
+                    let b = lookup.buffer(f, camera.eye - framing.center);
+                    pick(f, b, &mut uses);
                     picks.push(b);
                 }
             }
         }
-        Draws { scene, orders, options, raster, cameras, picks, uses }
+        Draws { scene, orders, options, raster, frames, cameras, picks, uses, frame_of }
     }
 
     /// The view set and image size, when there are views.
@@ -235,7 +256,8 @@ impl<'a> Draws<'a> {
 
     /// The triangles of buffer `b`, in its draw order.
     pub fn triangles(&self, b: usize) -> Vec<[u32; 3]> {
-        self.scene.mesh.triangles_in_order(&self.orders.buffers[b].order)
+        let frame = self.scene.frames.triangles(self.frame_of[b], &self.scene.mesh);
+        self.orders.buffers[b].order.iter().map(|&t| frame[t as usize]).collect()
     }
 
     /// The buffers some draw uses, with how many draws use each.
@@ -246,17 +268,23 @@ impl<'a> Draws<'a> {
     /// The views of frame `f` grouped by the buffer that draws them, in buffer order.
     pub fn groups(&self, f: usize) -> Vec<(usize, Vec<usize>)> {
         let views = self.cameras.len();
+        let row = (f - self.frames.start) * views;
         let mut by_buffer: Vec<Vec<usize>> = vec![Vec::new(); self.orders.buffers.len()];
-        for (v, &b) in self.picks[f * views..(f + 1) * views].iter().enumerate() {
+        for (v, &b) in self.picks[row..row + views].iter().enumerate() {
             by_buffer[b].push(v);
         }
         by_buffer.into_iter().enumerate().filter(|(_, g)| !g.is_empty()).collect()
     }
 
+    /// The positions of frame `f`.
+    pub fn positions(&self, f: usize) -> &[glam::Vec3] {
+        &self.scene.frames.frames[f]
+    }
+
     /// The clips whose values are reported on their own: each clip when an animation has several.
-    pub fn clips(&self) -> &[(String, std::ops::Range<usize>)] {
+    pub fn clips(&self) -> &[(String, Range<usize>)] {
         let clips = &self.scene.frames.clips;
-        if clips.len() > 1 { clips } else { &[] }
+        if self.scene.frames.is_animation() && clips.len() > 1 { clips } else { &[] }
     }
 }
 
@@ -274,6 +302,11 @@ impl std::fmt::Debug for Measured {
 }
 
 impl Measured {
+    /// The values about one level of a progressive mesh (`None`: values not about a level).
+    pub fn at_level(&self, level: Option<usize>) -> Measured {
+        Measured { metric: self.metric, values: self.values.iter().filter(|v| v.level == level).cloned().collect() }
+    }
+
     /// How `eval`'s table shows these values: the metric's columns for its summary values.
     pub fn columns(&self) -> Vec<(String, String)> {
         let summaries: Vec<&Value> = self.values.iter().filter(|v| v.is_summary()).collect();
@@ -336,12 +369,22 @@ pub fn measure(
     options: &MeasureOptions,
     raster: &dyn RasterBackend,
 ) -> Result<Vec<Measured>> {
-    let draws = Draws::new(scene, orders, options, raster);
-    METRICS
-        .iter()
-        .filter(|m| !m.reported(options).is_empty())
-        .map(|&metric| Ok(Measured { metric, values: metric.measure(&draws)? }))
-        .collect()
+    // A progressive mesh is measured level by level, every value naming its level.
+    let parts: Vec<(Range<usize>, Option<usize>)> = match &scene.frames.kind {
+        Kind::Levels(_) => (0..scene.frames.len()).map(|f| (f..f + 1, Some(f))).collect(),
+        _ => vec![(0..scene.frames.len(), None)],
+    };
+    let draws: Vec<(Draws, Option<usize>)> =
+        parts.into_iter().map(|(frames, level)| (Draws::new(scene, orders, options, raster, frames), level)).collect();
+    let mut measured = Vec::new();
+    for &metric in METRICS.iter().filter(|m| !m.reported(options).is_empty()) {
+        let mut values = Vec::new();
+        for (draws, level) in &draws {
+            values.extend(metric.measure(draws)?.into_iter().map(|v| Value { level: *level, ..v }));
+        }
+        measured.push(Measured { metric, values });
+    }
+    Ok(measured)
 }
 
 /// The backend named `name`: `cpu` (the reference) or `gpu` (opens the Vulkan device; fails with

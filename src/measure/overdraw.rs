@@ -77,21 +77,22 @@ impl Metric for Overdraw {
     /// with several, each with the per-view ratios (`ovr`) of the views that see something.
     fn measure(&self, draws: &Draws) -> Result<Vec<Value>> {
         let views = draws.cameras.len();
-        let mut per_view = vec![ViewCounts::default(); draws.scene.frames.len() * views];
-        for (f, positions) in draws.scene.frames.frames.iter().enumerate() {
+        let first = draws.frames.start;
+        let mut per_view = vec![ViewCounts::default(); draws.frames.len() * views];
+        for f in draws.frames.clone() {
             for (b, group) in draws.groups(f) {
                 let cameras: Vec<_> = group.iter().map(|&v| draws.cameras[v]).collect();
-                let counts = draws.raster.count(positions, &draws.triangles(b), &cameras, draws.options.res)?;
+                let counts = draws.raster.count(draws.positions(f), &draws.triangles(b), &cameras, draws.options.res)?;
                 for (&v, c) in group.iter().zip(counts) {
-                    per_view[f * views + v] = c;
+                    per_view[(f - first) * views + v] = c;
                 }
             }
         }
-        let all = std::iter::once((None, 0..draws.scene.frames.len()));
+        let all = std::iter::once((None, draws.frames.clone()));
         let clips = draws.clips().iter().map(|(name, frames)| (Some(name.clone()), frames.clone()));
         let mut values = Vec::new();
         for (clip, frames) in all.chain(clips) {
-            let counts = &per_view[frames.start * views..frames.end * views];
+            let counts = &per_view[(frames.start - first) * views..(frames.end - first) * views];
             let at = |metric: &'static str, value: f64| Value {
                 views: draws.views(),
                 clip: clip.clone(),

@@ -11,9 +11,9 @@
 //!   viewpoints. The radius is the largest over all frames, so one sphere of viewpoints (and one
 //!   camera distance) serves the whole animation.
 //!
-//! Progressive levels will be a third kind: frames whose triangles differ too, each level with
-//! its own order; measurement already works frame by frame through [`Frames::framing`] and the
-//! lookup of each method's orders.
+//! - **Levels** of a progressive mesh: one frame a level, the positions unchanged but each level
+//!   with its own triangles ([`Frames::triangles`]); a method's sequence follows the removals
+//!   by an [`Update`], and every metric is reported level by level.
 
 use std::ops::Range;
 
@@ -22,6 +22,7 @@ use rayon::prelude::*;
 
 use super::Mesh;
 use super::animated::Animated;
+use super::progressive::{History, Update};
 
 /// How a model is framed: bounding-box centre and the largest vertex distance from it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,9 +53,39 @@ pub struct Frames {
     pub clips: Vec<(String, Range<usize>)>,
     /// How every frame is seen: one centre and radius for all of them.
     pub framing: Framing,
-    /// True for the keyframes of an animation, false for a still: results name the frames of an
-    /// animation by clip.
-    pub animated: bool,
+    /// What the frames are, which decides how they are drawn and how results name them.
+    pub kind: Kind,
+}
+
+/// What a scene's frames are.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Kind {
+    /// One frame, the mesh as it stands.
+    Still,
+    /// The keyframes of an animation, one connectivity: results name them by clip.
+    Animation,
+    /// Levels of a progressive mesh, one frame each, each with its own triangles: every metric is
+    /// reported per level.
+    Levels(Levels),
+}
+
+/// The levels of a progressive mesh and how a rendering sequence follows them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Levels {
+    pub history: History,
+    /// Per level: the fraction of the mesh's triangles asked for, the removals that reach it, and
+    /// its triangles (ids into `history.triangles`, ascending).
+    pub fractions: Vec<f64>,
+    pub records: Vec<usize>,
+    pub alive: Vec<Vec<u32>>,
+    pub update: Update,
+}
+
+impl Levels {
+    /// The triangles of level `f` (corners), in id order.
+    pub fn triangles(&self, f: usize) -> Vec<[u32; 3]> {
+        self.alive[f].iter().map(|&t| self.history.triangles[t as usize]).collect()
+    }
 }
 
 impl Frames {
@@ -73,7 +104,7 @@ impl Frames {
             frame.iter_mut().for_each(|p| *p -= framing.center);
             radius = radius.max(framing.radius);
         }
-        Frames { frames, clips, framing: Framing { center: Vec3::ZERO, radius }, animated: true }
+        Frames { frames, clips, framing: Framing { center: Vec3::ZERO, radius }, kind: Kind::Animation }
     }
 
     /// A static mesh: one frame, its positions untouched, framed where it stands.
@@ -82,7 +113,38 @@ impl Frames {
             frames: vec![mesh.positions.clone()],
             clips: vec![(String::new(), 0..1)],
             framing: Framing::of(&mesh.positions),
-            animated: false,
+            kind: Kind::Still,
+        }
+    }
+
+    /// `mesh` at each fraction of its triangle count (descending), by `history`'s removals: one
+    /// frame a level, framed where the mesh stands. A fraction the history cannot reach gives the
+    /// coarsest level it has.
+    pub fn levels(mesh: &Mesh, history: History, fractions: &[f64], update: Update) -> Frames {
+        let records: Vec<usize> = fractions
+            .iter()
+            .map(|f| history.records_for((f * mesh.triangle_count() as f64).round() as usize))
+            .collect();
+        let alive = records.iter().map(|&r| history.level(r)).collect();
+        let levels = Levels { history, fractions: fractions.to_vec(), records, alive, update };
+        Frames {
+            frames: vec![mesh.positions.clone(); fractions.len()],
+            clips: vec![(String::new(), 0..fractions.len())],
+            framing: Framing::of(&mesh.positions),
+            kind: Kind::Levels(levels),
+        }
+    }
+
+    /// True for the keyframes of an animation.
+    pub fn is_animation(&self) -> bool {
+        self.kind == Kind::Animation
+    }
+
+    /// The triangles frame `f` draws: the mesh's, or for a level its own.
+    pub fn triangles<'a>(&'a self, f: usize, mesh: &'a Mesh) -> std::borrow::Cow<'a, [[u32; 3]]> {
+        match &self.kind {
+            Kind::Levels(levels) => std::borrow::Cow::Owned(levels.triangles(f)),
+            _ => std::borrow::Cow::Borrowed(&mesh.triangles),
         }
     }
 
@@ -126,7 +188,7 @@ mod tests {
         }
         let scaled: Vec<Vec3> = animated.mesh.positions.iter().map(|&p| 3.0 * p).collect();
         assert_eq!(k.framing, Framing { center: Vec3::ZERO, radius: Framing::of(&scaled).radius });
-        assert!(k.animated);
+        assert!(k.is_animation());
     }
 
     #[test]
@@ -141,6 +203,6 @@ mod tests {
         let still = Frames::still(&mesh);
         assert_eq!(still.frames, vec![mesh.positions.clone()]);
         assert_eq!(still.framing, Framing::of(&mesh.positions));
-        assert!(!still.animated);
+        assert!(!still.is_animation());
     }
 }

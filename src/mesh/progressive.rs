@@ -33,6 +33,35 @@ use glam::DVec3;
 use super::Mesh;
 use super::topology::Topology;
 
+/// How a rendering sequence follows a progressive mesh's levels (Bogomjakov & Gotsman 2002, §3):
+/// kept through the removals by the simple or the smart update (`order::levels`), or made anew
+/// for each level by the method itself, the paper's reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Update {
+    Simple,
+    Smart,
+    Reorder,
+}
+
+impl Update {
+    pub fn name(self) -> &'static str {
+        match self {
+            Update::Simple => "simple",
+            Update::Smart => "smart",
+            Update::Reorder => "reorder",
+        }
+    }
+
+    pub fn parse(text: &str) -> crate::Result<Update> {
+        match text {
+            "simple" => Ok(Update::Simple),
+            "smart" => Ok(Update::Smart),
+            "reorder" => Ok(Update::Reorder),
+            other => Err(crate::Error::usage(format!("unknown update `{other}` (simple, smart or reorder)"))),
+        }
+    }
+}
+
 /// One vertex removal: `removed` was moved onto `kept`; the triangles `before` (ids into
 /// [`History::triangles`]) were replaced by the triangles `after`.
 #[derive(Debug, Clone, PartialEq)]

@@ -17,24 +17,63 @@
 //! The two positions a removal leaves unused stay empty: a renderer draws the sequence with its
 //! holes skipped (compacted, the relative order kept), which is what [`Sequence::order`] returns.
 
-use crate::mesh::progressive::{History, Record};
+use std::time::Instant;
 
-use super::Order;
+use crate::error::Result;
+use crate::mesh::frames::Levels;
+use crate::mesh::progressive::{History, Record, Update};
+use crate::mesh::{Mesh, Scene};
 
-/// How a rendering sequence follows the removals.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Update {
-    Simple,
-    Smart,
-}
+use super::{Clustered, Lookup, Order, Orders, Resolved, needs_one_order};
 
-impl Update {
-    pub fn name(self) -> &'static str {
-        match self {
-            Update::Simple => "simple",
-            Update::Smart => "smart",
-        }
+/// The orders of `resolved` for every level of `scene` (whose frames are `levels`): its sequence
+/// of the full mesh kept through the removals by the simple or smart update, or, for
+/// [`Update::Reorder`], the method run anew on each level's mesh. Buffer f draws level f; each is
+/// an order of that level's triangles (indices into its list).
+pub fn run(resolved: &Resolved, scene: &Scene, levels: &Levels) -> Result<Orders> {
+    if resolved.method.per_node {
+        return Err(needs_one_order(resolved.method.name, "a progressive mesh cannot keep its sequence"));
     }
+    let one = |scene: &Scene| -> Result<Order> {
+        let orders = resolved.ordering.order(scene)?;
+        let buffer =
+            orders.single().ok_or_else(|| needs_one_order(resolved.method.name, "it has no sequence to keep"))?;
+        Ok(buffer.order.clone())
+    };
+    let start = Instant::now();
+    let (buffers, phases) = match levels.update {
+        Update::Reorder => {
+            let buffers = (0..levels.alive.len())
+                .map(|f| one(&Scene::still(Mesh { triangles: levels.triangles(f), ..scene.mesh.clone() })))
+                .collect::<Result<Vec<_>>>()?;
+            (buffers, vec![("order every level", start.elapsed().as_secs_f64())])
+        }
+        update => {
+            // A static method orders `scene.mesh`, the full-resolution mesh, whatever the frames.
+            let order = one(scene)?;
+            let ordered = start.elapsed().as_secs_f64();
+            let sequences = self::levels(&levels.history, &order, update == Update::Smart, &levels.records);
+            let buffers = sequences
+                .iter()
+                .zip(&levels.alive)
+                .map(|(sequence, alive)| {
+                    sequence
+                        .iter()
+                        .map(|t| alive.binary_search(t).expect("a level draws its own triangles") as u32)
+                        .collect()
+                })
+                .collect();
+            (buffers, vec![("order", ordered), ("update", start.elapsed().as_secs_f64() - ordered)])
+        }
+    };
+    let per_level: Vec<u16> = (0..buffers.len() as u16).collect();
+    Ok(Orders {
+        buffers: buffers.into_iter().map(Clustered::single).collect(),
+        lookup: Lookup::per_frame(&per_level),
+        iterations: None,
+        converged: true,
+        phases,
+    })
 }
 
 /// Marks an empty position.
@@ -59,8 +98,8 @@ impl Sequence {
         Sequence { slots: order.to_vec(), position }
     }
 
-    /// Applies one removal.
-    pub fn apply(&mut self, history: &History, record: &Record, update: Update) {
+    /// Applies one removal, by the smart update or else the simple one.
+    pub fn apply(&mut self, history: &History, record: &Record, smart_update: bool) {
         let mut freed: Vec<(u32, u32)> = record.before.iter().map(|&t| (self.position[t as usize], t)).collect();
         freed.sort_unstable();
         for &(p, t) in &freed {
@@ -68,10 +107,7 @@ impl Sequence {
             self.position[t as usize] = EMPTY;
         }
         let new: Vec<u32> = record.after.clone().collect();
-        let chosen = match update {
-            Update::Simple => (0..new.len()).collect(),
-            Update::Smart => smart(history, &freed, &new),
-        };
+        let chosen = if smart_update { smart(history, &freed, &new) } else { (0..new.len()).collect() };
         for (&t, &j) in new.iter().zip(&chosen) {
             let p = freed[j].0;
             self.slots[p as usize] = t;
@@ -130,14 +166,15 @@ fn smart(history: &History, freed: &[(u32, u32)], new: &[u32]) -> Vec<usize> {
 }
 
 /// The sequence of each level, each level given as a number of removals (ascending), from
-/// `order` at full resolution kept by `update`: per level, the triangle ids in drawing order.
-pub fn levels(history: &History, order: &[u32], update: Update, levels: &[usize]) -> Vec<Order> {
+/// `order` at full resolution kept by the smart update (or else the simple one): per level, the
+/// triangle ids in drawing order.
+pub fn levels(history: &History, order: &[u32], smart_update: bool, levels: &[usize]) -> Vec<Order> {
     let mut sequence = Sequence::new(history, order);
     let mut applied = 0;
     let mut out = Vec::with_capacity(levels.len());
     for &records in levels {
         for record in &history.records[applied..records] {
-            sequence.apply(history, record, update);
+            sequence.apply(history, record, smart_update);
         }
         applied = applied.max(records);
         out.push(sequence.order());
@@ -156,7 +193,7 @@ mod tests {
         let mesh = procedural::generate("sphere:2000", 1).unwrap().unwrap();
         let history = History::build(&mesh, &Topology::new(&mesh), 200);
         let order: Vec<u32> = (0..mesh.triangle_count() as u32).rev().collect();
-        for update in [Update::Simple, Update::Smart] {
+        for update in [false, true] {
             let mut sequence = Sequence::new(&history, &order);
             for (i, record) in history.records.iter().enumerate() {
                 let before = sequence.clone();
@@ -164,18 +201,18 @@ mod tests {
                 // Every triangle the removal did not touch keeps its position.
                 for (p, &t) in before.slots.iter().enumerate() {
                     if t != EMPTY && !record.before.contains(&t) {
-                        assert_eq!(sequence.slots[p], t, "{update:?} record {i} moved triangle {t}");
+                        assert_eq!(sequence.slots[p], t, "smart {update} record {i} moved triangle {t}");
                     }
                 }
                 // New triangles sit only where removed ones were.
                 for t in record.after.clone() {
                     let p = sequence.position[t as usize] as usize;
-                    assert!(record.before.contains(&before.slots[p]), "{update:?} record {i}");
+                    assert!(record.before.contains(&before.slots[p]), "smart {update} record {i}");
                 }
             }
             let mut drawn = sequence.order();
             drawn.sort_unstable();
-            assert_eq!(drawn, history.level(history.records.len()), "{update:?}");
+            assert_eq!(drawn, history.level(history.records.len()), "smart {update}");
         }
     }
 
@@ -213,7 +250,7 @@ mod tests {
             let triangles: Vec<[u32; 3]> = drawn.iter().map(|&t| history.triangles[t as usize]).collect();
             simulate(CacheModel::Fifo(16), &triangles, mesh.vertex_count()).acmr()
         };
-        let (simple, smart) = (acmr(Update::Simple), acmr(Update::Smart));
+        let (simple, smart) = (acmr(false), acmr(true));
         assert!(smart <= simple * 1.01, "smart {smart} against simple {simple}");
     }
 }

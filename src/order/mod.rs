@@ -20,6 +20,7 @@ pub mod meshopt;
 
 use crate::error::{Error, Result};
 use crate::mesh::Scene;
+use crate::mesh::frames::Kind;
 pub use orders::{Clustered, Lookup, Orders};
 pub use params::{MethodSpec, ParamInfo, ParamKind, Params};
 
@@ -129,14 +130,18 @@ pub fn resolve(spec: &str, run_seed: u64) -> Result<Resolved> {
 /// clusters tile it, a lookup for one frame or for every frame of the scene, naming buffers that
 /// exist. So no caller ever measures or writes a wrong order silently.
 pub fn run(resolved: &Resolved, scene: &Scene) -> Result<Orders> {
-    let orders = resolved.ordering.order(scene)?;
-    let n = scene.mesh.triangle_count();
+    let orders = match &scene.frames.kind {
+        Kind::Levels(levels) => levels::run(resolved, scene, levels)?,
+        _ => resolved.ordering.order(scene)?,
+    };
     let frames = scene.frames.len();
     let checked = orders
         .buffers
         .iter()
         .enumerate()
         .try_for_each(|(i, b)| {
+            let n = drawn_by(&orders.lookup, i, frames)
+                .map_or(scene.mesh.triangle_count(), |f| scene.frames.triangles(f, &scene.mesh).len());
             check_permutation(&b.order, n)
                 .and_then(|()| if tiles(&b.starts, n) { Ok(()) } else { Err("its clusters do not tile it".into()) })
                 .map_err(|why| format!("buffer {i}: {why}"))
@@ -156,6 +161,16 @@ pub fn run(resolved: &Resolved, scene: &Scene) -> Result<Orders> {
         Error::usage(format!("internal error: `{}` returned invalid orders: {why}", resolved.canonical()))
     })?;
     Ok(orders)
+}
+
+/// The first of `frames` frames whose lookup cells pick buffer `b`: the frame whose triangles it
+/// orders (on a progressive mesh each level has its own).
+pub fn drawn_by(lookup: &Lookup, b: usize, frames: usize) -> Option<usize> {
+    let cells = lookup.cells_per_frame();
+    (0..frames).find(|&f| {
+        let f = f.min(lookup.frames() - 1);
+        lookup.cells()[f * cells..(f + 1) * cells].iter().any(|&c| usize::from(c) == b)
+    })
 }
 
 /// The error for a method with several buffers where one order is needed.

@@ -14,6 +14,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::measure::Corner;
 use crate::measure::Evaluation;
+use crate::mesh::frames::Kind;
 use crate::mesh::{Mesh, Scene, Source};
 
 /// The CSV header, in order (checked against [`Row`] by a test).
@@ -24,6 +25,8 @@ pub const COLUMNS: &[&str] = &[
     "model_triangles",
     "model_vertices",
     "clip",
+    "level",
+    "update",
     "method",
     "method_name",
     "peer",
@@ -55,6 +58,11 @@ pub struct Row {
     /// For an animation, the clip a row measures, or `all` for all its frames (and for the rows
     /// that do not depend on the clip: times, caches, buffers); empty for a static mesh.
     pub clip: Option<String>,
+    /// For a progressive mesh, the level a row measures, as the fraction of the mesh's triangles
+    /// asked for (`model_triangles` is what the level has); empty otherwise.
+    pub level: Option<f64>,
+    /// For a progressive mesh, how the sequence follows the levels: simple, smart or reorder.
+    pub update: Option<&'static str>,
     /// Canonical method spec (every parameter).
     pub method: String,
     pub method_name: String,
@@ -97,12 +105,33 @@ impl Context {
     /// buffers when `buffers` says the run compares them, the iterations of a method that
     /// iterates, and last the ordering's time.
     pub fn rows(&self, model: &str, source: &Source, scene: &Scene, eval: &Evaluation, buffers: bool) -> Vec<Row> {
-        let all = scene.frames.animated.then(|| "all".to_string());
-        let base = Row { clip: all.clone(), ..self.base(model, source, &scene.mesh, eval) };
+        let all = scene.frames.is_animation().then(|| "all".to_string());
+        let levels = match &scene.frames.kind {
+            Kind::Levels(levels) => Some(levels),
+            _ => None,
+        };
+        let base = Row {
+            clip: all.clone(),
+            update: levels.map(|l| l.update.name()),
+            ..self.base(model, source, &scene.mesh, eval)
+        };
+        // The level a value is about, as its own model size.
+        let at_level = |level: Option<usize>| match (levels, level) {
+            (Some(levels), Some(f)) => {
+                let triangles = levels.triangles(f);
+                let vertices = crate::measure::cache::referenced(&triangles, scene.mesh.vertex_count());
+                (Some(levels.fractions[f]), triangles.len(), vertices)
+            }
+            _ => (None, base.model_triangles, base.model_vertices),
+        };
         let mut rows: Vec<Row> = eval
             .values()
             .filter(|v| self.per_view || v.view.is_none())
-            .map(|v| Row {
+            .map(|v| (v, at_level(v.level)))
+            .map(|(v, (level, model_triangles, model_vertices))| Row {
+                level,
+                model_triangles,
+                model_vertices,
                 metric: v.metric,
                 cache: v.cache.as_ref().map(|c| c.name.clone()),
                 cache_kind: v.cache.as_ref().map(|c| c.kind),
@@ -137,6 +166,8 @@ impl Context {
             model_triangles: mesh.triangle_count(),
             model_vertices: mesh.vertex_count(),
             clip: None,
+            level: None,
+            update: None,
             method: eval.method.clone(),
             method_name: eval.method_name.to_string(),
             peer: eval.peer,
@@ -272,6 +303,8 @@ mod tests {
             model_triangles: 0,
             model_vertices: 0,
             clip: None,
+            level: None,
+            update: None,
             method: String::new(),
             method_name: String::new(),
             peer: false,
