@@ -106,6 +106,9 @@ enum BenchPart {
     Orderings,
     /// The GPU raster backend vs the CPU one (ico:162 at 512²); needs a Vulkan adapter.
     Backends,
+    /// Progressive meshes: the simplification history vs meshoptimizer's simplifier, and the
+    /// cost of the simple and smart updates per vertex removal.
+    Progressive,
 }
 
 #[derive(Subcommand)]

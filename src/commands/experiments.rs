@@ -108,6 +108,31 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
         }
         return Ok(());
     }
+    if only == Some(BenchPart::Progressive) {
+        println!("\nprogressive meshes down to 1% of the triangles (speedup = meshopt time / ours)");
+        println!(
+            "{:<28} {:>9}  {:<36} {:>9} {:>10} {:>10} {:>8} {:>11}",
+            "mesh", "triangles", "task", "removals", "ours ms", "meshopt ms", "speedup", "µs/removal"
+        );
+        for (model, scene) in &scenes {
+            for r in triorder::experiment::bench::compare_progressive(scene, reps) {
+                let theirs = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.1}", s * 1e3));
+                let speedup = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.2}x", s / r.ours_seconds));
+                println!(
+                    "{:<28} {:>9}  {:<36} {:>9} {:>10.1} {:>10} {:>8} {:>11.3}",
+                    model,
+                    r.triangles,
+                    r.task,
+                    r.removals,
+                    r.ours_seconds * 1e3,
+                    theirs,
+                    speedup,
+                    r.ours_seconds * 1e6 / r.removals.max(1) as f64
+                );
+            }
+        }
+        return Ok(());
+    }
     if only != Some(BenchPart::Orderings) {
         println!(
             "\n{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",

@@ -24,8 +24,10 @@ use std::time::Instant;
 
 use crate::measure::cache::{CacheModel, simulate};
 use crate::mesh::Framing;
+use crate::mesh::progressive::History;
 use crate::mesh::topology::vertex_triangles;
 use crate::mesh::{Mesh, Scene};
+use crate::order::levels::Sequence;
 use crate::order::{
     self,
     forsyth::{Scores, forsyth},
@@ -252,5 +254,55 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
         row("  the same, + adjacency", forsyth_with_adjacency, vcache_theirs, vcache_acmr),
         row("sander07 vs optimizeVertexCache+Overdraw(1.05)", sander_ours, overdraw_theirs, overdraw_acmr),
         row("  the same, + adjacency", sander_with_adjacency, overdraw_theirs, overdraw_acmr),
+    ]
+}
+
+/// One timing of the progressive-mesh machinery (Bogomjakov & Gotsman 2002, §3).
+#[derive(Debug, Clone)]
+pub struct ProgressiveRow {
+    pub task: String,
+    pub triangles: usize,
+    /// Vertex removals the task performs.
+    pub removals: usize,
+    pub ours_seconds: f64,
+    /// meshoptimizer's simplifier to the same triangle count, where it is a peer.
+    pub meshopt_seconds: Option<f64>,
+}
+
+/// Times, on `scene`'s mesh: the simplification history down to 1 % of the triangles against
+/// `meshopt_simplify` to the same count (no error bound: both run to the count), and the simple and
+/// smart updates of a sequence (Tipsify's, FIFO 16) through every removal of that history, which
+/// meshoptimizer has no peer for. meshoptimizer's simplifier does edge collapses too, but keeps no
+/// history and stops where its error bound says; ours records each removal for the updates.
+pub fn compare_progressive(scene: &Scene, reps: usize) -> Vec<ProgressiveRow> {
+    let mesh = &scene.mesh;
+    let target = mesh.triangle_count() / 100;
+    let indices = mesh.index_buffer();
+    let positions = mesh.meshopt_positions();
+    let simplify =
+        || meshopt::simplify(&indices, &positions, target * 3, f32::MAX, meshopt::SimplifyOptions::None, None);
+    let build = || History::build(mesh, &scene.topology, target);
+    let [ours, theirs] =
+        median_interleaved(reps, [&mut || drop(black_box(build())), &mut || drop(black_box(simplify()))]);
+    let history = build();
+    let (order, _) = tipsify(&mesh.triangles, &scene.topology.vertex_triangles, 16);
+    let update = |smart: bool| {
+        let mut sequence = Sequence::new(&history, &order);
+        history.records.iter().for_each(|r| sequence.apply(&history, r, smart));
+        sequence
+    };
+    let [simple, smart] =
+        median_interleaved(reps, [&mut || drop(black_box(update(false))), &mut || drop(black_box(update(true)))]);
+    let row = |task: &str, ours_seconds: f64, meshopt_seconds: Option<f64>| ProgressiveRow {
+        task: task.to_string(),
+        triangles: mesh.triangle_count(),
+        removals: history.records.len(),
+        ours_seconds,
+        meshopt_seconds,
+    };
+    vec![
+        row("history to 1% vs meshopt_simplify", ours, Some(theirs)),
+        row("simple update, every removal", simple, None),
+        row("smart update, every removal", smart, None),
     ]
 }
