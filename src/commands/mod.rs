@@ -99,6 +99,9 @@ pub fn eval(
     let mut scene = open(&source, common)?;
     if !progressive.levels.is_empty() {
         scene = scene.with_levels(&progressive.levels, update)?;
+        if let Some(note) = scene.frames.levels().and_then(|l| l.note(&progressive.levels)) {
+            eprintln!("{}: note: {note}", scene.mesh.name);
+        }
     }
     let buffers = scene.frames.is_animation() || resolved.iter().any(|r| r.method.per_node);
     let mut table = tables::EvalTable::new(buffers);

@@ -6,7 +6,6 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 use triorder::measure::{Evaluation, Measured, Value};
-use triorder::mesh::frames::Kind;
 use triorder::mesh::{Mesh, Scene};
 
 /// `eval`'s readable table: one row per method, the columns its metrics show.
@@ -128,11 +127,11 @@ pub fn eval_json(scene: &Scene, e: &Evaluation, backend: &str) -> Vec<String> {
 /// The level index, fraction and triangle count of each level of `scene`, or one entry of `None`s
 /// (and the mesh's count) for a scene without levels.
 fn levels(scene: &Scene) -> Vec<(Option<usize>, Option<f64>, usize)> {
-    match &scene.frames.kind {
-        Kind::Levels(levels) => {
+    match scene.frames.levels() {
+        Some(levels) => {
             (0..levels.alive.len()).map(|f| (Some(f), Some(levels.fractions[f]), levels.alive[f].len())).collect()
         }
-        _ => vec![(None, None, scene.mesh.triangle_count())],
+        None => vec![(None, None, scene.mesh.triangle_count())],
     }
 }
 
@@ -146,16 +145,11 @@ fn json_line(
     triangles: usize,
 ) -> String {
     let mesh = &scene.mesh;
-    let update = match &scene.frames.kind {
-        Kind::Levels(levels) => Some(levels.update.name()),
-        _ => None,
-    };
-    let vertices = match &scene.frames.kind {
-        Kind::Levels(levels) => {
-            triorder::measure::cache::referenced(&levels.triangles(level.unwrap_or(0)), mesh.vertex_count())
-        }
-        _ => mesh.vertex_count(),
-    };
+    let levels = scene.frames.levels();
+    let update = levels.map(|l| l.update.name());
+    let vertices = levels.map_or(mesh.vertex_count(), |l| {
+        triorder::measure::cache::referenced(&l.triangles(level.unwrap_or(0)), mesh.vertex_count())
+    });
     let mut line = EvalLine {
         mesh: &mesh.name,
         method: &e.method,

@@ -19,8 +19,8 @@ use crate::atomic;
 use crate::error::{Error, Result};
 use crate::figure::spec::FigureKind;
 use crate::measure::{self, Evaluation, cache};
-use crate::mesh::{Scene, source};
-use crate::order;
+use crate::mesh::{Mesh, Scene, source};
+use crate::order::{self, Clustered};
 use crate::raster::{cpu, views};
 use crate::results::{Context, OrderRow, Row};
 
@@ -89,6 +89,9 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         if !work.levels.is_empty() {
             bar.set_message(format!("{}: simplifying", model.name));
             scene = scene.with_levels(&work.levels, spec.updates[0])?;
+            if let Some(note) = scene.frames.levels().and_then(|l| l.note(&work.levels)) {
+                bars.suspend(|| eprintln!("{}: note: {note}", model.name));
+            }
         }
         // Without levels the one update is never used.
         let updates = if work.levels.is_empty() { &spec.updates[..1] } else { &spec.updates[..] };
@@ -100,7 +103,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
                 let buffers = per_node || scene.frames.is_animation();
                 rows.extend(context.rows(&model.name, &model.source, &scene, &evaluation, buffers));
                 if spec.figure.kind.draws_meshes() {
-                    orders.push(drawn(spec, &model.name, &scene, &evaluation, &options.caches)?);
+                    orders.extend(drawn(spec, &model.name, &scene, &evaluation, &options.caches)?);
                 }
                 bar.inc(1);
             }
@@ -119,19 +122,44 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
 
 /// What a drawing of `evaluation` needs beyond the geometry: the order and its clusters, and for
 /// the kinds that show a measurement, that measurement per drawn triangle or pixel, so figures
-/// never replay the cache simulator or the rasterizer.
+/// never replay the cache simulator or the rasterizer. One row, or one per level of a progressive
+/// mesh (each level's order indexes that level's triangles).
 fn drawn(
     spec: &Spec,
     model: &str,
     scene: &Scene,
     evaluation: &Evaluation,
     caches: &[measure::CacheModel],
+) -> Result<Vec<OrderRow>> {
+    let one_order =
+        || order::needs_one_order(evaluation.method_name, "a drawing of the mesh in its order cannot show it");
+    let Some(levels) = scene.frames.levels() else {
+        let buffer = evaluation.orders.single().ok_or_else(one_order)?;
+        return Ok(vec![drawn_one(spec, model, &scene.mesh, evaluation, buffer, caches)?]);
+    };
+    (0..levels.alive.len())
+        .map(|f| {
+            let mesh = Mesh { triangles: levels.triangles(f), ..scene.mesh.clone() };
+            let buffer = evaluation.orders.buffers.get(f).ok_or_else(one_order)?;
+            Ok(OrderRow {
+                level: levels.fractions[f].to_string(),
+                update: levels.update.name().to_string(),
+                ..drawn_one(spec, model, &mesh, evaluation, buffer, caches)?
+            })
+        })
+        .collect()
+}
+
+/// [`drawn`] for one buffer drawing `mesh`.
+fn drawn_one(
+    spec: &Spec,
+    model: &str,
+    mesh: &Mesh,
+    evaluation: &Evaluation,
+    buffer: &Clustered,
+    caches: &[measure::CacheModel],
 ) -> Result<OrderRow> {
-    let buffer = evaluation.orders.single().ok_or_else(|| {
-        order::needs_one_order(evaluation.method_name, "a drawing of the mesh in its order cannot show it")
-    })?;
     let words = |values: &mut dyn Iterator<Item = String>| values.collect::<Vec<_>>().join(" ");
-    let mesh = &scene.mesh;
     let triangles = mesh.triangles_in_order(&buffer.order);
     let corners = match spec.figure.kind {
         FigureKind::Corners => caches
@@ -159,6 +187,8 @@ fn drawn(
         clusters: words(&mut buffer.starts.iter().map(usize::to_string)),
         corners,
         overdraw,
+        level: String::new(),
+        update: String::new(),
     })
 }
 

@@ -60,7 +60,8 @@
 //!                                  # may name another metric of the same model and method,
 //!                                  # "metric:acmr"
 //! series = "method"                # optional (default method): one colour per value
-//! facet = "model"                  # optional: one small chart per value, all in one SVG
+//! facet = "model"                  # optional: one small chart per value, all in one SVG;
+//!                                  # series and facet may join columns, "model+method"
 //! filter = { cache_kind = "fifo" } # optional: keep only rows whose columns equal these values
 //! x_label = "FIFO size"            # optional axis labels (defaults name the column or metric)
 //! y_label = "ACMR"

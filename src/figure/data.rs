@@ -132,8 +132,12 @@ impl Table {
     /// Where a figure reads a column `name`: a CSV column; `param:NAME`, a parameter of the method
     /// (read from its canonical spec); `source:KEY`, a key of the animated model; or, for x and
     /// bar labels only, `metric:NAME`, the value of that metric for the same model and method (so
-    /// one metric can be plotted against, or written on, another).
+    /// one metric can be plotted against, or written on, another); `A+B`, several of them joined
+    /// (series or panels by, say, model and method at once).
     fn resolve(&self, name: &str) -> Result<Column> {
+        if name.contains('+') {
+            return Ok(Column::Joined(name.split('+').map(|part| self.resolve(part)).collect::<Result<_>>()?));
+        }
         if let Some(param) = name.strip_prefix("param:") {
             return Ok(Column::Param(self.column("method")?, param.to_string()));
         }
@@ -263,6 +267,8 @@ enum Column {
         method: usize,
         values: Vec<((String, String), String)>,
     },
+    /// Several columns, read together.
+    Joined(Vec<Column>),
 }
 
 impl Column {
@@ -275,6 +281,7 @@ impl Column {
                 .iter()
                 .find(|((m, s), _)| m == &record[*model] && s == &record[*method])
                 .map_or(String::new(), |(_, v)| v.clone()),
+            Column::Joined(parts) => parts.iter().map(|c| c.cell(record)).collect::<Vec<_>>().join(" "),
         }
     }
 
@@ -285,6 +292,7 @@ impl Column {
         match (self, measure::names().find(|m| m.name == cell)) {
             (Column::Plain(_), Some(m)) => m.label.to_string(),
             (Column::Source(_, key), _) if !cell.is_empty() => format!("{key}={cell}"),
+            (Column::Joined(parts), _) => parts.iter().map(|c| c.label(record)).collect::<Vec<_>>().join(", "),
             _ => cell,
         }
     }

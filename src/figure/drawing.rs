@@ -29,6 +29,7 @@ use super::spec::FigureKind;
 use super::{Chart, Header, save};
 use crate::error::{Error, Result};
 use crate::measure::Corner;
+use crate::mesh::progressive::Update;
 use crate::mesh::{Mesh, Source, Topology, source};
 use crate::order;
 use crate::raster::{cpu, views};
@@ -99,13 +100,27 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
             models.push((&row.model, Source::parse(&row.model)?.mesh(data.as_deref(), chart.seed)?));
         }
     }
+    let levels = level_meshes(&saved, data.as_deref(), chart.seed)?;
     let kind = chart.figure.kind;
-    let acmrs = table.rows("acmr", &["model", "method", "cache"])?;
+    // Results written before progressive meshes have no level or update columns.
+    let key: &[&str] = if levels.is_empty() {
+        &["model", "method", "cache"]
+    } else {
+        &["model", "method", "cache", "level", "update"]
+    };
+    let acmrs = table.rows("acmr", key)?;
+    let one_method = saved.iter().all(|r| r.method == saved[0].method);
     let mut drawings = Vec::new();
     for row in &saved {
         let (model, method) = (row.model.as_str(), row.method.as_str());
-        let mesh = &models.iter().find(|(m, _)| *m == model).expect("every model is loaded").1;
-        let label = if models.len() > 1 { format!("{}: ", short(model)) } else { String::new() };
+        let mesh = match levels.iter().find(|(m, l, _)| *m == model && *l == row.level) {
+            Some((_, _, mesh)) => mesh,
+            None => &models.iter().find(|(m, _)| *m == model).expect("every model is loaded").1,
+        };
+        let mut label = if models.len() > 1 { format!("{}: ", short(model)) } else { String::new() };
+        if !row.level.is_empty() {
+            label += &format!("{} triangles · {} · ", mesh.triangle_count(), row.update);
+        }
         let order: Vec<u32> = words(&row.order).map_err(|e| stale(format!("`{method}` on `{model}`: {e}")))?;
         let starts: Vec<usize> = words(&row.clusters).map_err(|e| stale(format!("`{method}` on `{model}`: {e}")))?;
         order::check_permutation(&order, mesh.triangle_count())
@@ -114,9 +129,14 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
             return Err(stale(format!("the clusters of `{method}` on `{model}` do not tile its order")));
         }
         let triangles = mesh.triangles_in_order(&order);
-        let recorded: Vec<(&str, f64)> =
-            acmrs.iter().filter(|(c, _)| c[0] == model && c[1] == method).map(|(c, v)| (c[2].as_str(), *v)).collect();
-        let name = method.split(':').next().unwrap_or(method);
+        let recorded: Vec<(&str, f64)> = acmrs
+            .iter()
+            .filter(|(c, _)| c[0] == model && c[1] == method && (levels.is_empty() || same_level(&c[3..], row)))
+            .map(|(c, v)| (c[2].as_str(), *v))
+            .collect();
+        // Panels that differ only by level name the level, not the one method.
+        let name = if one_method && !row.level.is_empty() { "" } else { method.split(':').next().unwrap_or(method) };
+        let label = if name.is_empty() { label.trim_end_matches(" · ").to_string() } else { label };
         match kind {
             FigureKind::Sequence => {
                 let topology = Topology::new(mesh);
@@ -219,6 +239,47 @@ where
     text.split_whitespace().map(|w| w.parse::<T>().map_err(|e| format!("`{w}`: {e}"))).collect()
 }
 
+/// Whether the results' `[level, update]` cells are those of an orders row (levels compared as
+/// numbers: the results write `1.0`, the orders `1`).
+fn same_level(cells: &[String], row: &OrderRow) -> bool {
+    cells[0].parse::<f64>().ok() == row.level.parse::<f64>().ok() && cells[1] == row.update
+}
+
+/// The meshes of the levels the orders draw, per model: `(model, level, mesh)`. The
+/// simplification history is deterministic, so it is built again here rather than saved.
+fn level_meshes<'a>(saved: &'a [OrderRow], data: Option<&Path>, seed: u64) -> Result<Vec<(&'a str, &'a str, Mesh)>> {
+    let mut out = Vec::new();
+    let mut models: Vec<&str> = Vec::new();
+    for row in saved.iter().filter(|r| !r.level.is_empty()) {
+        if !models.contains(&row.model.as_str()) {
+            models.push(&row.model);
+        }
+    }
+    for model in models {
+        let mut asked: Vec<&str> = Vec::new();
+        for row in saved.iter().filter(|r| r.model == model && !r.level.is_empty()) {
+            if !asked.contains(&row.level.as_str()) {
+                asked.push(&row.level);
+            }
+        }
+        let fractions = asked
+            .iter()
+            .map(|l| {
+                l.parse::<f64>().map_err(|_| Error::input(model, format!("level `{l}` in the orders is not a number")))
+            })
+            .collect::<Result<Vec<f64>>>()?;
+        let scene = Source::parse(model)?.open(data, seed)?.with_levels(&fractions, Update::Smart)?;
+        let levels = scene.frames.levels().expect("a scene with levels");
+        for (&level, fraction) in asked.iter().zip(&fractions) {
+            let f = levels.fractions.iter().position(|x| x == fraction).ok_or_else(|| {
+                Error::input(model, format!("level {level} is not reached by the simplification; rerun the experiment"))
+            })?;
+            out.push((model, level, Mesh { triangles: levels.triangles(f), ..scene.mesh.clone() }));
+        }
+    }
+    Ok(out)
+}
+
 /// The orders file's rows, in the order the run wrote them; a second row for the same model and
 /// method is an error.
 fn read_orders(path: &Path) -> Result<Vec<OrderRow>> {
@@ -232,10 +293,13 @@ fn read_orders(path: &Path) -> Result<Vec<OrderRow>> {
     for (i, row) in reader.deserialize::<OrderRow>().enumerate() {
         let line = i + 2;
         let row = row.map_err(|e| Error::input(path.display(), format!("line {line}: {e}")))?;
-        if rows.iter().any(|r| r.model == row.model && r.method == row.method) {
+        if rows
+            .iter()
+            .any(|r| r.model == row.model && r.method == row.method && r.level == row.level && r.update == row.update)
+        {
             return Err(Error::input(
                 path.display(),
-                format!("line {line}: a second order for the same model and method"),
+                format!("line {line}: a second order for the same model, method and level"),
             ));
         }
         rows.push(row);

@@ -231,10 +231,12 @@ impl RawFigure {
         if self.x_log && matches!(self.kind, FigureKind::Bar | FigureKind::Distribution) {
             return Err(format!("figure.x_log: kind = \"{}\" has no numeric x axis", kind_name(self.kind)));
         }
+        // Series and panels may join columns: `model+method`.
+        let joined = |key: &str, name: &str| name.split('+').try_for_each(|part| column(key, part, false));
         let series = self.series.unwrap_or_else(|| "method".into());
-        column("figure.series", &series, false)?;
+        joined("figure.series", &series)?;
         if let Some(facet) = &self.facet {
-            column("figure.facet", facet, false)?;
+            joined("figure.facet", facet)?;
         }
         let mut filter = Vec::new();
         for (key, value) in self.filter {

@@ -79,6 +79,23 @@ pub struct Levels {
     pub records: Vec<usize>,
     pub alive: Vec<Vec<u32>>,
     pub update: Update,
+    /// Where the history stopped, in triangles, when it stopped above a level asked for (which is
+    /// then left out): no vertex left could be removed without a fold or a non-manifold result.
+    pub stopped: Option<usize>,
+}
+
+impl Levels {
+    /// A note for the user when some level asked for is not reached.
+    pub fn note(&self, asked: &[f64]) -> Option<String> {
+        let stopped = self.stopped?;
+        let missing: Vec<String> =
+            asked.iter().filter(|f| !self.fractions.contains(f)).map(|f| f.to_string()).collect();
+        Some(format!(
+            "the simplification stops at {stopped} triangles (no vertex left can be removed without a fold \
+             or a non-manifold result); level(s) {} left out",
+            missing.join(", ")
+        ))
+    }
 }
 
 impl Levels {
@@ -120,18 +137,33 @@ impl Frames {
     /// `mesh` at each fraction of its triangle count (descending), by `history`'s removals: one
     /// frame a level, framed where the mesh stands. A fraction the history cannot reach gives the
     /// coarsest level it has.
-    pub fn levels(mesh: &Mesh, history: History, fractions: &[f64], update: Update) -> Frames {
-        let records: Vec<usize> = fractions
-            .iter()
-            .map(|f| history.records_for((f * mesh.triangle_count() as f64).round() as usize))
-            .collect();
+    pub fn progressive(mesh: &Mesh, history: History, fractions: &[f64], update: Update) -> Frames {
+        // A level the history does not reach would repeat the one before it: it is left out.
+        let mut kept: Vec<(f64, usize)> = Vec::with_capacity(fractions.len());
+        for &f in fractions {
+            let records = history.records_for((f * mesh.triangle_count() as f64).round() as usize);
+            if kept.last().is_none_or(|&(_, r)| records > r) {
+                kept.push((f, records));
+            }
+        }
+        let stopped = (kept.len() < fractions.len()).then(|| history.level(history.records.len()).len());
+        let (fractions, records): (Vec<f64>, Vec<usize>) = kept.into_iter().unzip();
         let alive = records.iter().map(|&r| history.level(r)).collect();
-        let levels = Levels { history, fractions: fractions.to_vec(), records, alive, update };
+        let count = fractions.len();
+        let levels = Levels { history, fractions, records, alive, update, stopped };
         Frames {
-            frames: vec![mesh.positions.clone(); fractions.len()],
-            clips: vec![(String::new(), 0..fractions.len())],
+            frames: vec![mesh.positions.clone(); count],
+            clips: vec![(String::new(), 0..count)],
             framing: Framing::of(&mesh.positions),
             kind: Kind::Levels(levels),
+        }
+    }
+
+    /// The levels of a progressive mesh, if these frames are its levels.
+    pub fn levels(&self) -> Option<&Levels> {
+        match &self.kind {
+            Kind::Levels(levels) => Some(levels),
+            _ => None,
         }
     }
 

@@ -155,10 +155,12 @@ impl Quadric {
     }
 }
 
-/// A collapse waiting in the queue: cheapest first, ties by vertex id.
+/// A collapse waiting in the queue: cheapest first; ties (as on a flat region, where every
+/// error is zero) by the shorter edge, so that flat parts thin out evenly, then by vertex id.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Candidate {
     error: f64,
+    length2: f64,
     vertex: u32,
     kept: u32,
     version: u32,
@@ -168,7 +170,9 @@ impl Eq for Candidate {}
 
 impl Ord for Candidate {
     fn cmp(&self, other: &Self) -> Ordering {
-        other.error.total_cmp(&self.error).then(other.vertex.cmp(&self.vertex))
+        let key = |c: &Candidate| (c.error, c.length2, c.vertex);
+        let (a, b) = (key(other), key(self));
+        a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2))
     }
 }
 
@@ -184,8 +188,11 @@ struct Scratch {
     fan: Vec<(u32, u32, u32)>,
     ring_v: Vec<u32>,
     ring_u: Vec<u32>,
-    options: Vec<(f64, u32)>,
+    options: Vec<Cost>,
 }
+
+/// A collapse as (quadric error, squared edge length, vertex kept).
+type Cost = (f64, f64, u32);
 
 struct Simplifier<'a> {
     positions: Vec<DVec3>,
@@ -200,7 +207,7 @@ struct Simplifier<'a> {
     /// Bumped whenever a vertex's queued collapse changes: queue entries of older versions are stale.
     version: Vec<u32>,
     /// Each vertex's collapse in the queue at its current version, if any.
-    queued: Vec<Option<(f64, u32)>>,
+    queued: Vec<Option<Cost>>,
     removed: Vec<bool>,
     queue: BinaryHeap<Candidate>,
     /// The model's extent squared, for the zero-area test.
@@ -257,7 +264,9 @@ impl<'a> Simplifier<'a> {
             .queued
             .iter()
             .enumerate()
-            .filter_map(|(v, o)| o.map(|(error, kept)| Candidate { error, vertex: v as u32, kept, version: 0 }))
+            .filter_map(|(v, o)| {
+                o.map(|(error, length2, kept)| Candidate { error, length2, vertex: v as u32, kept, version: 0 })
+            })
             .collect::<Vec<_>>()
             .into();
         let mut scratch = Scratch::default();
@@ -365,8 +374,8 @@ impl<'a> Simplifier<'a> {
         })
     }
 
-    /// `v`'s cheapest valid collapse, as (error, vertex kept), if it has one.
-    fn option(&self, v: u32, scratch: &mut Scratch) -> Option<(f64, u32)> {
+    /// `v`'s cheapest valid collapse, if it has one.
+    fn option(&self, v: u32, scratch: &mut Scratch) -> Option<Cost> {
         if self.removed[v as usize] || !self.unshared(v) || !self.fan(v, &mut scratch.fan) {
             return None;
         }
@@ -375,15 +384,16 @@ impl<'a> Simplifier<'a> {
         // Cheapest first (ties by vertex id), so that usually only one collapse is checked.
         options.clear();
         for &(_, u, _) in fan.iter() {
-            if options.iter().any(|&(_, k)| k == u) || !self.unshared(u) {
+            if options.iter().any(|&(_, _, k)| k == u) || !self.unshared(u) {
                 continue;
             }
             let mut q = self.quadrics[v as usize];
             q.add(&self.quadrics[u as usize]);
-            options.push((q.error(self.positions[u as usize]).max(0.0), u));
+            let p = self.positions[u as usize];
+            options.push((q.error(p).max(0.0), p.distance_squared(self.positions[v as usize]), u));
         }
-        options.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        options.iter().copied().find(|&(_, u)| self.valid(v, u, fan, ring_v, ring_u))
+        options.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+        options.iter().copied().find(|&(_, _, u)| self.valid(v, u, fan, ring_v, ring_u))
     }
 
     /// Requeues `v` when its cheapest collapse changed: a new version, the old entry left stale.
@@ -394,8 +404,8 @@ impl<'a> Simplifier<'a> {
         }
         self.queued[v as usize] = option;
         self.version[v as usize] += 1;
-        if let Some((error, kept)) = option {
-            self.queue.push(Candidate { error, vertex: v, kept, version: self.version[v as usize] });
+        if let Some((error, length2, kept)) = option {
+            self.queue.push(Candidate { error, length2, vertex: v, kept, version: self.version[v as usize] });
         }
     }
 

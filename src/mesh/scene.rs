@@ -48,7 +48,7 @@ impl Scene {
         let smallest = fractions.last().ok_or_else(|| Error::usage("no level given"))?;
         let target = (smallest * self.mesh.triangle_count() as f64).round() as usize;
         let history = History::build(&self.mesh, &self.topology, target);
-        let frames = Frames::levels(&self.mesh, history, &fractions, update);
+        let frames = Frames::progressive(&self.mesh, history, &fractions, update);
         Ok(Scene { frames, ..self })
     }
 

@@ -14,7 +14,6 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::measure::Corner;
 use crate::measure::Evaluation;
-use crate::mesh::frames::Kind;
 use crate::mesh::{Mesh, Scene, Source};
 
 /// The CSV header, in order (checked against [`Row`] by a test).
@@ -106,10 +105,7 @@ impl Context {
     /// iterates, and last the ordering's time.
     pub fn rows(&self, model: &str, source: &Source, scene: &Scene, eval: &Evaluation, buffers: bool) -> Vec<Row> {
         let all = scene.frames.is_animation().then(|| "all".to_string());
-        let levels = match &scene.frames.kind {
-            Kind::Levels(levels) => Some(levels),
-            _ => None,
-        };
+        let levels = scene.frames.levels();
         let base = Row {
             clip: all.clone(),
             update: levels.map(|l| l.update.name()),
@@ -213,6 +209,13 @@ pub struct OrderRow {
     /// For `overdraw` drawings: the fragments shaded at each pixel from the figure's view, a
     /// greyscale PNG in base64 ([`OrderRow::encode_counts`]). Empty otherwise.
     pub overdraw: String,
+    /// For a progressive mesh: the level (fraction of the triangles) this order draws, whose
+    /// triangles the order indexes, and the update that kept it. Empty otherwise (and in orders
+    /// files written before levels existed).
+    #[serde(default)]
+    pub level: String,
+    #[serde(default)]
+    pub update: String,
 }
 
 /// The digits of [`OrderRow::encode_corners`].
