@@ -1,0 +1,147 @@
+//! Progressive meshes on real data (Bogomjakov & Gotsman 2002, §3): every registered static
+//! ordering as the starting sequence of every update, each level's buffer a permutation of that
+//! level's triangles, the survivors of a removal kept in their relative order, every level
+//! oriented as consistently as the full mesh, and the smart update against the simple one on
+//! every shared model. Nothing here names a method: a new ordering gets these tests by being
+//! registered.
+
+mod common;
+
+use std::collections::HashMap;
+
+use triorder::measure::cache::{CacheModel, simulate};
+use triorder::mesh::frames::Levels;
+use triorder::mesh::progressive::Update;
+use triorder::mesh::{Mesh, Scene, procedural};
+use triorder::order::{self, METHODS};
+
+const LEVELS: [f64; 4] = [1.0, 0.5, 0.25, 0.1];
+
+fn levels(scene: &Scene) -> &Levels {
+    scene.frames.levels().expect("a scene with levels")
+}
+
+/// The global triangle ids (into the history) that level `f`'s buffer draws, in draw order.
+fn drawn(levels: &Levels, buffer: &[u32], f: usize) -> Vec<u32> {
+    buffer.iter().map(|&i| levels.alive[f][i as usize]).collect()
+}
+
+/// Directed edges used by more than one triangle: 0 on a consistently oriented manifold.
+fn misoriented(triangles: &[[u32; 3]]) -> usize {
+    let mut seen: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in triangles.iter().filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) {
+        for k in 0..3 {
+            *seen.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    seen.values().filter(|&&n| n > 1).count()
+}
+
+/// Every static method under every update on `mesh`: one buffer a level, a permutation of that
+/// level's triangles; under simple and smart, the triangles two consecutive levels share are
+/// drawn in the same relative order (an update never moves an unaffected triangle). Methods
+/// with several buffers a frame are refused with an error that says why.
+fn check_every_method(mesh: &Mesh) {
+    let scene = Scene::still(mesh.clone()).with_levels(&LEVELS, Update::Smart).unwrap();
+    let reached = levels(&scene).alive.len();
+    assert!(reached >= 2, "{}: the history reaches only {reached} level(s)", mesh.name);
+    // Simplification keeps the orientation: no level has more doubly used directed edges than
+    // the full mesh (where fins and duplicates already put some).
+    let full = misoriented(&mesh.triangles);
+    for f in 0..reached {
+        let n = misoriented(&levels(&scene).triangles(f));
+        assert!(n <= full, "{} level {f}: {n} directed edges used twice, {full} at full resolution", mesh.name);
+    }
+    for update in [Update::Simple, Update::Smart, Update::Reorder] {
+        let mut scene = scene.clone();
+        scene.set_update(update);
+        let levels = levels(&scene);
+        for method in METHODS {
+            let what = format!("{} {} on {}", method.name, update.name(), mesh.name);
+            let resolved = order::resolve(method.name, 3).unwrap();
+            let result = order::run(&resolved, &scene);
+            if method.per_node {
+                let err = result.err().unwrap_or_else(|| panic!("{what}: accepted")).to_string();
+                assert!(err.contains("progressive"), "{what}: {err}");
+                continue;
+            }
+            let orders = result.unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert_eq!(orders.buffers.len(), reached, "{what}: one buffer a level");
+            let sequences: Vec<Vec<u32>> = (0..reached)
+                .map(|f| {
+                    let buffer = &orders.buffers[orders.lookup.buffer(f, glam::Vec3::Z)].order;
+                    order::check_permutation(buffer, levels.alive[f].len())
+                        .unwrap_or_else(|why| panic!("{what}, level {f}: {why}"));
+                    drawn(levels, buffer, f)
+                })
+                .collect();
+            if update == Update::Reorder {
+                continue;
+            }
+            for f in 1..reached {
+                let (before, after) = (&levels.alive[f - 1], &levels.alive[f]);
+                let kept_before: Vec<u32> =
+                    sequences[f - 1].iter().copied().filter(|t| after.binary_search(t).is_ok()).collect();
+                let kept_after: Vec<u32> =
+                    sequences[f].iter().copied().filter(|t| before.binary_search(t).is_ok()).collect();
+                assert_eq!(kept_before, kept_after, "{what}: level {f} moved a triangle its removals left alone");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_method_keeps_well_formed_sequences_on_a_procedural_disk() {
+    check_every_method(&procedural::generate("disk:950", 1).unwrap().unwrap());
+}
+
+/// Real, irregular meshes: one closed, one with non-manifold edges from decimation, one
+/// quad-dominant with seams and boundaries.
+#[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
+fn every_method_keeps_well_formed_sequences_on_real_meshes() {
+    for name in ["bunny_2k.ply", "dragon_vrip_res4.ply", "pirate.obj"] {
+        check_every_method(&common::real_mesh(name));
+    }
+}
+
+/// FIFO-16 ACMR of level `f` drawn in `buffer`'s order.
+fn acmr(scene: &Scene, buffer: &[u32], f: usize) -> f64 {
+    let triangles = levels(scene).triangles(f);
+    let ordered: Vec<[u32; 3]> = buffer.iter().map(|&i| triangles[i as usize]).collect();
+    simulate(CacheModel::Fifo(16), &ordered, scene.mesh.vertex_count()).acmr()
+}
+
+/// The paper's claim behind the smart update: it keeps the sequence's locality where the simple
+/// one scatters new triangles over freed positions far apart. On every shared model, from a
+/// universal sequence (recursive cut) and a cache-tuned one (Tipsify), at each level down to a
+/// tenth of the triangles, smart is never worse than simple by more than noise (0.5% of ACMR).
+/// The table it prints is the one the issue asks to report.
+#[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
+fn smart_is_never_worse_than_simple_on_any_shared_model() {
+    let mut worse = Vec::new();
+    eprintln!("model, method, level triangles: FIFO-16 ACMR simple / smart / reorder");
+    for name in common::STATIC_MODELS {
+        let mesh = common::real_mesh(name);
+        let mut scene = Scene::still(mesh).with_levels(&LEVELS[1..], Update::Simple).unwrap();
+        for spec in ["recursive-cut", "tipsify:cache=16"] {
+            let resolved = order::resolve(spec, 0).unwrap();
+            let mut per_update = Vec::new();
+            for update in [Update::Simple, Update::Smart, Update::Reorder] {
+                scene.set_update(update);
+                let orders = order::run(&resolved, &scene).unwrap();
+                let buffers = orders.buffers.iter().map(|b| b.order.as_slice());
+                per_update.push(buffers.enumerate().map(|(f, b)| acmr(&scene, b, f)).collect::<Vec<_>>());
+            }
+            for (f, count) in levels(&scene).alive.iter().map(Vec::len).enumerate() {
+                let (simple, smart, reorder) = (per_update[0][f], per_update[1][f], per_update[2][f]);
+                eprintln!("{name}, {spec}, {count}: {simple:.3} / {smart:.3} / {reorder:.3}");
+                if smart > simple * 1.005 {
+                    worse.push(format!("{name} {spec} at {count} triangles: smart {smart:.4}, simple {simple:.4}"));
+                }
+            }
+        }
+    }
+    assert!(worse.is_empty(), "smart worse than simple:\n{}", worse.join("\n"));
+}
