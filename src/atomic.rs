@@ -11,6 +11,27 @@ use crate::error::{Error, Result};
 
 /// Writes what `fill` produces to `path` atomically. Errors name `path`.
 pub fn write_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
+    let staged = stage(path, fill)?;
+    staged.persist(path).map_err(|e| Error::output(path, e.error))?;
+    Ok(())
+}
+
+/// Writes a set of files that belong together (the levels of a progressive mesh, one file
+/// each): every file is written to its temporary first, and only when all are complete are they
+/// renamed into place, so a failure leaves none of the set, new or half-written.
+pub fn write_all(files: Vec<(&Path, Fill<'_>)>) -> Result<()> {
+    let staged = files.into_iter().map(|(path, fill)| Ok((path, stage(path, fill)?))).collect::<Result<Vec<_>>>()?;
+    for (path, tmp) in staged {
+        tmp.persist(path).map_err(|e| Error::output(path, e.error))?;
+    }
+    Ok(())
+}
+
+/// What writes one file's bytes.
+pub type Fill<'a> = Box<dyn FnOnce(&mut dyn Write) -> std::io::Result<()> + 'a>;
+
+/// `fill`'s output in a temporary file beside `path`, removed if it is dropped unpersisted.
+fn stage(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -28,8 +49,7 @@ pub fn write_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Res
         let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut buffered).and_then(|()| buffered.flush()).map_err(|e| Error::output(path, e))?;
     }
-    tmp.persist(path).map_err(|e| Error::output(path, e.error))?;
-    Ok(())
+    Ok(tmp)
 }
 
 /// Writes `bytes` to `path` atomically.

@@ -67,11 +67,12 @@ struct Measure {
     backend: String,
 }
 
-/// Progressive levels to measure, for `eval` on a static mesh.
+/// Progressive levels to measure (`eval`) or write (`order`), for a static mesh.
 #[derive(Args, Clone, Default)]
 struct Progressive {
-    /// Simplify the mesh by vertex removals (least quadric error first) and measure it at each
-    /// of these fractions of its triangles, e.g. 1,0.5,0.25,0.1 (Bogomjakov & Gotsman 2002, §3).
+    /// Simplify the mesh by vertex removals (least quadric error first) to each of these
+    /// fractions of its triangles, e.g. 1,0.5,0.25,0.1 (Bogomjakov & Gotsman 2002, §3): `eval`
+    /// measures every level, `order` writes them.
     #[arg(long, value_name = "F,F,...", value_delimiter = ',')]
     levels: Vec<f64>,
     /// How the method's sequence follows the levels: smart or simple (the paper's updates, from
@@ -119,6 +120,12 @@ enum Command {
     ///
     /// Prints the ACMR before and after (and OVR with --views). The output is written
     /// atomically: on any failure no partial file is left.
+    ///
+    /// With --levels it writes a progressive mesh (Bogomjakov & Gotsman 2002, §3): the mesh
+    /// simplified to each fraction of its triangles, the method's sequence kept by --update. A
+    /// GLB holds the vertices once and one index buffer per level (scene i draws level i, the
+    /// default scene the first); OBJ and PLY get one file per level, OUT.leveli.EXT, each with
+    /// every vertex so vertex numbers hold across levels.
     Order {
         /// Input mesh: a file (OBJ, PLY, GLB/glTF) or a procedural spec such as grid:16x8.
         input: String,
@@ -133,6 +140,8 @@ enum Command {
         remap_vertices: bool,
         #[command(flatten)]
         measure: Measure,
+        #[command(flatten)]
+        progressive: Progressive,
     },
     /// Order a mesh with one or more methods and measure each order.
     ///
@@ -206,8 +215,8 @@ fn main() -> ExitCode {
     let common = &cli.common;
     let result = match cli.command {
         Command::Methods => commands::methods(),
-        Command::Order { input, output, method, remap_vertices, measure } => {
-            commands::order(&input, &output, &method, remap_vertices, &measure, common)
+        Command::Order { input, output, method, remap_vertices, measure, progressive } => {
+            commands::order(&input, &output, &method, remap_vertices, &measure, &progressive, common)
         }
         Command::Eval { mesh, methods, measure, animation, progressive, json } => {
             commands::eval(&mesh, &methods, &measure, &animation, &progressive, json, common)

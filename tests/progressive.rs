@@ -145,3 +145,72 @@ fn smart_is_never_worse_than_simple_on_any_shared_model() {
     }
     assert!(worse.is_empty(), "smart worse than simple:\n{}", worse.join("\n"));
 }
+
+/// `triorder order --levels` writes what the library computes: in a GLB, scene i draws level i
+/// with the method's sequence kept by the update, indexing the one shared vertex buffer; in OBJ
+/// and PLY, one file per level with the same triangles, corner for corner. A set that cannot be
+/// written entirely leaves no file.
+#[test]
+fn order_writes_every_level() {
+    use std::process::Command;
+    let source = "assets/spot.obj";
+    let mesh = triorder::mesh::load::load_file(std::path::Path::new(source)).unwrap();
+    let fractions = [1.0, 0.5, 0.2];
+    let scene = Scene::still(mesh.clone()).with_levels(&fractions, Update::Smart).unwrap();
+    let resolved = order::resolve("tipsify", 0).unwrap();
+    let orders = order::run(&resolved, &scene).unwrap();
+    let expected: Vec<Vec<[u32; 3]>> = (0..fractions.len())
+        .map(|f| {
+            let triangles = levels(&scene).triangles(f);
+            orders.buffers[f].order.iter().map(|&i| triangles[i as usize]).collect()
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let order = |out: &std::path::Path| {
+        Command::new(env!("CARGO_BIN_EXE_triorder"))
+            .args(["order", source, "-o", out.to_str().unwrap(), "-m", "tipsify", "--levels", "1,0.5,0.2"])
+            .output()
+            .unwrap()
+    };
+
+    let glb = dir.path().join("spot.glb");
+    let o = order(&glb);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (document, buffers, _) = gltf::import(&glb).unwrap();
+    assert_eq!(document.default_scene().map(|s| s.index()), Some(0), "the full level is the default scene");
+    let written: Vec<Vec<[u32; 3]>> = document
+        .scenes()
+        .map(|scene| {
+            let nodes: Vec<_> = scene.nodes().collect();
+            assert_eq!(nodes.len(), 1, "one node a level");
+            let primitive = nodes[0].mesh().unwrap().primitives().next().unwrap();
+            let reader = primitive.reader(|b| Some(&buffers[b.index()]));
+            let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+            assert_eq!(reader.read_positions().unwrap().count(), mesh.vertex_count(), "the vertices, once, all");
+            indices.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
+        })
+        .collect();
+    assert_eq!(written, expected);
+
+    let obj = dir.path().join("spot.obj");
+    let o = order(&obj);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (f, triangles) in expected.iter().enumerate() {
+        let level = triorder::mesh::load::load_file(&dir.path().join(format!("spot.level{f}.obj"))).unwrap();
+        let corners = |m: &Mesh, t: &[u32; 3]| t.map(|v| m.positions[v as usize].to_array().map(f32::to_bits));
+        let got: Vec<_> = level.triangles.iter().map(|t| corners(&level, t)).collect();
+        let want: Vec<_> = triangles.iter().map(|t| corners(&mesh, t)).collect();
+        assert_eq!(got, want, "level {f}");
+    }
+    assert!(!dir.path().join("spot.obj").exists(), "levels go to their own files");
+
+    // The third level's file is a directory: the write fails, and no level file is left.
+    let ply = dir.path().join("spot.ply");
+    std::fs::create_dir(dir.path().join("spot.level2.ply")).unwrap();
+    let o = order(&ply);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("spot.level2.ply"));
+    for f in 0..2 {
+        assert!(!dir.path().join(format!("spot.level{f}.ply")).exists(), "level {f} was written alone");
+    }
+}

@@ -9,11 +9,11 @@ pub use experiments::{bench, plot, reproduce, run};
 use std::path::Path;
 
 use triorder::gpu::render_time::{MAX_FRAMES, Shading};
-use triorder::measure::{self, CacheModel, MeasureOptions};
+use triorder::measure::{self, CacheModel, MeasureOptions, Measured};
 use triorder::mesh::gltf::animation::ClipSelection;
 use triorder::mesh::progressive::Update;
 use triorder::mesh::source::{self, AnimationSource};
-use triorder::mesh::{Scene, Source};
+use triorder::mesh::{Mesh, Scene, Source};
 use triorder::order::{self, METHODS, Orders, params::describe_kind};
 use triorder::raster::{RasterBackend, ViewSet};
 use triorder::{Error, Result};
@@ -98,10 +98,7 @@ pub fn eval(
     let update = Update::parse(&progressive.update)?;
     let mut scene = open(&source, common)?;
     if !progressive.levels.is_empty() {
-        scene = scene.with_levels(&progressive.levels, update)?;
-        if let Some(note) = scene.frames.levels().and_then(|l| l.note(&progressive.levels)) {
-            eprintln!("{}: note: {note}", scene.mesh.name);
-        }
+        scene = with_levels(scene, &progressive.levels, update)?;
     }
     let buffers = scene.frames.is_animation() || resolved.iter().any(|r| r.method.per_node);
     let mut table = tables::EvalTable::new(buffers);
@@ -152,6 +149,7 @@ pub fn order(
     method: &str,
     remap_vertices: bool,
     measure: &Measure,
+    progressive: &Progressive,
     common: &Common,
 ) -> Result<()> {
     let measuring = Measuring::new(measure, common.seed)?;
@@ -159,6 +157,7 @@ pub fn order(
     if resolved.method.per_node {
         return Err(order::needs_one_order(resolved.method.name, "`order` cannot write it"));
     }
+    let update = Update::parse(&progressive.update)?;
     let source = Source::parse(source)?;
     if source.is_animation() {
         return Err(Error::usage(format!(
@@ -172,7 +171,11 @@ pub fn order(
     if triorder::mesh::save::format_of(output).is_none() {
         return Err(Error::output(output, "unknown output format (use .obj, .ply or .glb)"));
     }
-    let scene = open(&source, common)?;
+    let mut scene = open(&source, common)?;
+    if !progressive.levels.is_empty() {
+        scene = with_levels(scene, &progressive.levels, update)?;
+        return order_levels(scene, output, &resolved, remap_vertices, &measuring);
+    }
     let identity: Vec<u32> = (0..scene.mesh.triangle_count() as u32).collect();
     let before = measure::measure(&scene, &Orders::from(identity), &measuring.options, measuring.raster.as_ref())?;
     let after = measure::evaluate(&scene, &resolved, &measuring.options, measuring.raster.as_ref())?;
@@ -183,9 +186,7 @@ pub fn order(
         reordered = reordered.remap_vertices_first_use();
     }
     let saved = triorder::mesh::save::save(&reordered, output)?;
-    for dropped in &saved.dropped {
-        eprintln!("warning: {}: not written: {dropped}", output.display());
-    }
+    warn_dropped(output, &saved.dropped);
     println!("{}", tables::before_after(&before, &after.measured));
     println!(
         "wrote {} ({} triangles, {} ordered in {:.3} s)",
@@ -195,4 +196,78 @@ pub fn order(
         after.seconds
     );
     Ok(())
+}
+
+/// `order --levels`: every level drawn in the method's sequence kept by the update, written
+/// with the vertices shared. Before and after are printed per level, "before" being the level's
+/// triangles in the order the simplification leaves them (survivors in input order, then the
+/// triangles each removal added).
+fn order_levels(
+    mut scene: Scene,
+    output: &Path,
+    resolved: &order::Resolved,
+    remap_vertices: bool,
+    measuring: &Measuring,
+) -> Result<()> {
+    let (options, raster) = (&measuring.options, measuring.raster.as_ref());
+    let after = measure::evaluate(&scene, resolved, options, raster)?;
+    let update = scene.frames.levels().map_or(Update::Smart, |l| l.update);
+    scene.set_update(Update::Reorder);
+    let before = measure::evaluate(&scene, &order::resolve("input", 0)?, options, raster)?;
+    scene.set_update(update);
+    let levels = scene.frames.levels().expect("a scene with levels");
+    let mut named: Vec<(String, Vec<[u32; 3]>)> = (0..levels.alive.len())
+        .map(|f| {
+            let triangles = levels.triangles(f);
+            let buffer = &after.orders.buffers[after.orders.lookup.buffer(f, glam::Vec3::Z)].order;
+            let ordered: Vec<[u32; 3]> = buffer.iter().map(|&i| triangles[i as usize]).collect();
+            (format!("level {}: {} triangles", levels.fractions[f], ordered.len()), ordered)
+        })
+        .collect();
+    let mut mesh = scene.mesh.clone();
+    if remap_vertices {
+        // One numbering for every level, by first use in the first: it uses every vertex the
+        // others use, since removals only take vertices away.
+        let all = Mesh { triangles: named.iter().flat_map(|(_, t)| t.iter().copied()).collect(), ..mesh };
+        let remapped = all.remap_vertices_first_use();
+        let mut rest = remapped.triangles.as_slice();
+        for (_, triangles) in &mut named {
+            let (level, others) = rest.split_at(triangles.len());
+            triangles.copy_from_slice(level);
+            rest = others;
+        }
+        mesh = Mesh { triangles: named[0].1.clone(), ..remapped };
+    }
+    let (saved, paths) = triorder::mesh::save::save_levels(&mesh, &named, output)?;
+    warn_dropped(output, &saved.dropped);
+    for (f, (name, _)) in named.iter().enumerate() {
+        let at = |measured: &[Measured]| measured.iter().map(|m| m.at_level(Some(f))).collect::<Vec<_>>();
+        println!("{name}\n{}", tables::before_after(&at(&before.measured), &at(&after.measured)));
+    }
+    let files: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    println!(
+        "wrote {} ({} levels, {} kept by the {} update, ordered and updated in {:.3} s)",
+        files.join(", "),
+        named.len(),
+        after.method,
+        update.name(),
+        after.seconds
+    );
+    Ok(())
+}
+
+fn warn_dropped(output: &Path, dropped: &[String]) {
+    for dropped in dropped {
+        eprintln!("warning: {}: not written: {dropped}", output.display());
+    }
+}
+
+/// `scene` as a progressive mesh at `fractions`, saying on stderr which levels the history
+/// could not reach.
+fn with_levels(scene: Scene, fractions: &[f64], update: Update) -> Result<Scene> {
+    let scene = scene.with_levels(fractions, update)?;
+    if let Some(note) = scene.frames.levels().and_then(|l| l.note(fractions)) {
+        eprintln!("{}: note: {note}", scene.mesh.name);
+    }
+    Ok(scene)
 }

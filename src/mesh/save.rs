@@ -5,7 +5,7 @@
 //! or a temporary file behind.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, gltf, obj, ply};
@@ -42,19 +42,68 @@ pub fn format_of(path: &Path) -> Option<Format> {
 /// and winding are written exactly as in the mesh. On error nothing is left behind: neither a
 /// partial target nor a temporary file.
 pub fn save(mesh: &Mesh, path: &Path) -> Result<SaveReport> {
-    type Writer = fn(&Mesh, &mut dyn Write) -> std::io::Result<Vec<String>>;
-    let write: Writer = match format_of(path) {
-        Some(Format::Obj) => obj::write,
-        Some(Format::Ply) => ply::write,
-        Some(Format::Glb) => gltf::write,
-        None => {
-            return Err(Error::output(path, "unsupported file extension (supported: .obj, .ply, .glb)"));
-        }
-    };
+    let write = writer(path)?;
     let mut dropped = Vec::new();
     crate::atomic::write_with(path, |out| {
         dropped = write(mesh, out)?;
         Ok(())
     })?;
     Ok(SaveReport { dropped })
+}
+
+type Writer = fn(&Mesh, &mut dyn Write) -> std::io::Result<Vec<String>>;
+
+fn writer(path: &Path) -> Result<Writer> {
+    match format_of(path) {
+        Some(Format::Obj) => Ok(obj::write),
+        Some(Format::Ply) => Ok(ply::write),
+        Some(Format::Glb) => Ok(gltf::write),
+        None => Err(Error::output(path, "unsupported file extension (supported: .obj, .ply, .glb)")),
+    }
+}
+
+/// Writes the levels of a progressive mesh: `mesh`'s vertices with each level's triangles (a
+/// name and triangles indexing those vertices, in draw order). A GLB holds them all, the
+/// vertices once and an index buffer per level ([`gltf::write_levels`]); OBJ and PLY hold one
+/// mesh, so level i goes to `STEM.leveli.EXT` beside `path`, each with every vertex, so a vertex
+/// keeps its number at every level. All files are written or none ([`crate::atomic::write_all`]).
+/// Returns what was dropped and the files written.
+pub fn save_levels(mesh: &Mesh, levels: &[(String, Vec<[u32; 3]>)], path: &Path) -> Result<(SaveReport, Vec<PathBuf>)> {
+    let write = writer(path)?;
+    if format_of(path) == Some(Format::Glb) {
+        let borrowed: Vec<(String, &[[u32; 3]])> = levels.iter().map(|(n, t)| (n.clone(), t.as_slice())).collect();
+        crate::atomic::write_with(path, |out| gltf::write_levels(mesh, &borrowed, out).map(drop))?;
+        return Ok((SaveReport::default(), vec![path.to_path_buf()]));
+    }
+    let paths: Vec<PathBuf> = (0..levels.len()).map(|i| level_path(path, i)).collect();
+    let meshes: Vec<Mesh> =
+        levels.iter().map(|(_, triangles)| Mesh { triangles: triangles.clone(), ..mesh.clone() }).collect();
+    let dropped = std::cell::RefCell::new(Vec::new());
+    let files = paths
+        .iter()
+        .zip(&meshes)
+        .map(|(p, m)| {
+            let dropped = &dropped;
+            let fill: crate::atomic::Fill<'_> = Box::new(move |out| {
+                let lost = write(m, out)?;
+                let mut dropped = dropped.borrow_mut();
+                lost.into_iter().for_each(|d| {
+                    if !dropped.contains(&d) {
+                        dropped.push(d)
+                    }
+                });
+                Ok(())
+            });
+            (p.as_path(), fill)
+        })
+        .collect();
+    crate::atomic::write_all(files)?;
+    Ok((SaveReport { dropped: dropped.into_inner() }, paths))
+}
+
+/// `dir/STEM.leveli.EXT` for `dir/STEM.EXT`.
+fn level_path(path: &Path, i: usize) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    let extension = path.extension().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!("{stem}.level{i}.{extension}"))
 }

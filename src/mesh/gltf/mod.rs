@@ -19,7 +19,7 @@ mod primitive;
 mod scene;
 mod write;
 
-pub use write::write;
+pub use write::{write, write_levels};
 
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;

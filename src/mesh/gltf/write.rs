@@ -10,6 +10,15 @@ use crate::mesh::Mesh;
 /// stored as 32-bit floats or integers, so reading it back gives the same bits. GLB holds every
 /// attribute the mesh has, so nothing is dropped.
 pub fn write(mesh: &Mesh, out: &mut dyn Write) -> io::Result<Vec<String>> {
+    write_levels(mesh, &[(String::new(), &mesh.triangles)], out)
+}
+
+/// Writes `mesh`'s vertices once with one index buffer per entry of `levels` (a name and
+/// triangles indexing `mesh`'s vertices), as [`write`] does for one: the levels of a progressive
+/// mesh, which share their vertices. Level i is mesh i, drawn by node i, alone in scene i (named
+/// for the level); scene 0, the default, is the first level, so a viewer shows that one and an
+/// engine picks the others by scene or node. The names go in each scene and mesh.
+pub fn write_levels(mesh: &Mesh, levels: &[(String, &[[u32; 3]])], out: &mut dyn Write) -> io::Result<Vec<String>> {
     let a = &mesh.attributes;
     let mut bin: Vec<u8> = Vec::new();
     let mut views = Vec::new();
@@ -50,19 +59,33 @@ pub fn write(mesh: &Mesh, out: &mut dyn Write) -> io::Result<Vec<String>> {
     for e in &a.extra {
         add(&mut e.values.iter().copied(), "SCALAR", &format!("_{}", e.name), serde_json::Value::Null);
     }
-    let start = bin.len();
-    mesh.triangles.iter().flatten().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
-    views.push(serde_json::json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34963}));
-    accessors.push(serde_json::json!({
-        "bufferView": views.len() - 1, "componentType": 5125, "count": mesh.triangle_count() * 3, "type": "SCALAR"
-    }));
+    let (mut scenes, mut nodes, mut meshes) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (name, triangles)) in levels.iter().enumerate() {
+        let start = bin.len();
+        triangles.iter().flatten().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34963}),
+        );
+        accessors.push(serde_json::json!({
+            "bufferView": views.len() - 1, "componentType": 5125, "count": triangles.len() * 3, "type": "SCALAR"
+        }));
+        let primitive = serde_json::json!({"attributes": attributes, "indices": accessors.len() - 1, "mode": 4});
+        let (mut scene, mut named) = (serde_json::json!({"nodes": [i]}), mesh.name.clone());
+        if !name.is_empty() {
+            scene["name"] = name.as_str().into();
+            named = format!("{named} ({name})");
+        }
+        scenes.push(scene);
+        nodes.push(serde_json::json!({"mesh": i}));
+        meshes.push(serde_json::json!({"name": named, "primitives": [primitive]}));
+    }
 
     let json = serde_json::json!({
         "asset": {"version": "2.0", "generator": "triorder"},
         "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"name": mesh.name, "primitives": [{"attributes": attributes, "indices": accessors.len() - 1, "mode": 4}]}],
+        "scenes": scenes,
+        "nodes": nodes,
+        "meshes": meshes,
         "accessors": accessors,
         "bufferViews": views,
         "buffers": [{"byteLength": bin.len()}],
