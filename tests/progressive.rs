@@ -214,3 +214,123 @@ fn order_writes_every_level() {
         assert!(!dir.path().join(format!("spot.level{f}.ply")).exists(), "level {f} was written alone");
     }
 }
+
+/// FIFO-16 ACMR of every level of `source` under `spec` and `update`, straight from the library.
+fn library_acmr(source: &str, spec: &str, update: Update, fractions: &[f64]) -> Vec<(f64, usize, f64)> {
+    let mesh = triorder::mesh::Source::parse(source).unwrap().mesh(None, 0).unwrap();
+    let scene = Scene::still(mesh).with_levels(fractions, update).unwrap();
+    let orders = order::run(&order::resolve(spec, 0).unwrap(), &scene).unwrap();
+    let levels = levels(&scene);
+    (0..levels.alive.len())
+        .map(|f| (levels.fractions[f], levels.alive[f].len(), acmr(&scene, &orders.buffers[f].order, f)))
+        .collect()
+}
+
+/// `eval --levels --json` prints one object per method and level, with that level's fraction,
+/// triangle count, the update and the metrics the library measures there.
+#[test]
+fn eval_json_has_one_line_per_method_and_level() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_triorder"))
+        .args(["eval", "disk:950", "-m", "recursive-cut", "-m", "mla", "--levels", "0.2,1,0.5"])
+        .args(["--update", "simple", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lines: Vec<serde_json::Value> =
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 2 * 3);
+    for (method, spec) in [("recursive-cut:seed=0", "recursive-cut"), ("mla", "mla")] {
+        let mine: Vec<_> = lines.iter().filter(|l| l["method"] == method).collect();
+        let expected = library_acmr("disk:950", spec, Update::Simple, &[1.0, 0.5, 0.2]);
+        assert_eq!(mine.len(), expected.len(), "{method}");
+        for (line, (fraction, triangles, acmr)) in mine.iter().zip(expected) {
+            assert_eq!(line["update"], "simple");
+            assert_eq!(line["level"].as_f64(), Some(fraction), "{method}: levels from the most triangles");
+            assert_eq!(line["triangles"].as_u64(), Some(triangles as u64));
+            assert_eq!(line["acmr"].as_f64(), Some(acmr), "{method} at {fraction}");
+        }
+    }
+}
+
+/// A spec with levels and updates writes one ACMR row per model, method, level and update,
+/// each the library's value, and plots them.
+#[test]
+fn specs_measure_every_level_under_every_update() {
+    use triorder::experiment::{RunOptions, run};
+    let root = tempfile::tempdir().unwrap();
+    let text = r#"
+id = "levels"
+title = "Levels"
+question = "Do specs take levels?"
+claim = "They do (this test)."
+models = ["disk:950"]
+methods = ["recursive-cut", "tipsify"]
+caches = ["fifo:16"]
+levels = [1.0, 0.5, 0.2]
+updates = ["simple", "smart", "reorder"]
+
+[figure]
+kind = "line"
+metric = "acmr"
+x = "level"
+series = "update"
+facet = "model+method"
+
+[quick]
+models = ["disk:950"]
+"#;
+    let path = common::write_spec(root.path(), "levels", text);
+    let options = RunOptions { quick: true, out_dir: root.path().to_path_buf(), ..RunOptions::default() };
+    let csv = run(&path, &options).unwrap();
+    let mut reader = csv::Reader::from_path(&csv).unwrap();
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    let acmr_rows: Vec<_> = rows.iter().filter(|r| &r[column("metric")] == "acmr").collect();
+    assert_eq!(acmr_rows.len(), 2 * 3 * 3, "methods × updates × levels");
+    for (method, spec) in [("recursive-cut:seed=0", "recursive-cut"), ("tipsify:cache=16", "tipsify")] {
+        for update in [Update::Simple, Update::Smart, Update::Reorder] {
+            for (fraction, triangles, acmr) in library_acmr("disk:950", spec, update, &[1.0, 0.5, 0.2]) {
+                let hit: Vec<_> = acmr_rows
+                    .iter()
+                    .filter(|r| {
+                        &r[column("method")] == method
+                            && &r[column("update")] == update.name()
+                            && r[column("level")].parse::<f64>().unwrap() == fraction
+                    })
+                    .collect();
+                assert_eq!(hit.len(), 1, "{method} {} {fraction}", update.name());
+                assert_eq!(hit[0][column("model_triangles")].parse::<usize>().unwrap(), triangles);
+                assert_eq!(
+                    hit[0][column("value")].parse::<f64>().unwrap(),
+                    acmr,
+                    "{method} {} {fraction}",
+                    update.name()
+                );
+            }
+        }
+    }
+    let plotted = triorder::reproduce::plot(
+        &path,
+        &triorder::figure::PlotOptions { quick: true, out_dir: root.path().to_path_buf(), data: None },
+    )
+    .unwrap();
+    let svg = std::fs::read_to_string(plotted).unwrap();
+    for want in ["simple", "smart", "reorder", "disk:950, tipsify:cache=16"] {
+        assert!(svg.contains(want), "the figure lacks `{want}`");
+    }
+}
+
+/// Bad levels, updates and combinations are refused with the reason, before any work.
+#[test]
+fn bad_levels_are_refused_by_name() {
+    let eval = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_triorder")).arg("eval").args(args).output().unwrap();
+        assert!(!o.status.success(), "{args:?} was accepted");
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    assert!(eval(&["disk:950", "--levels", "0"]).contains("level 0 is not a fraction"));
+    assert!(eval(&["disk:950", "--levels", "1.5"]).contains("level 1.5 is not a fraction"));
+    assert!(eval(&["disk:950", "--levels", "0.5", "--update", "clever"]).contains("clever"));
+    assert!(eval(&["disk:950", "--levels", "0.5", "-m", "hs17"]).contains("progressive"));
+}
