@@ -266,7 +266,7 @@ fn warn_dropped(output: &Path, dropped: &[String]) {
 /// could not reach.
 fn with_levels(scene: Scene, fractions: &[f64], update: Update) -> Result<Scene> {
     let scene = scene.with_levels(fractions, update)?;
-    if let Some(note) = scene.frames.levels().and_then(|l| l.note(fractions)) {
+    if let Some(note) = scene.frames.levels().and_then(|l| l.note.as_ref()) {
         eprintln!("{}: note: {note}", scene.mesh.name);
     }
     Ok(scene)

@@ -89,7 +89,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         if !work.levels.is_empty() {
             bar.set_message(format!("{}: simplifying", model.name));
             scene = scene.with_levels(&work.levels, spec.updates[0])?;
-            if let Some(note) = scene.frames.levels().and_then(|l| l.note(&work.levels)) {
+            if let Some(note) = scene.frames.levels().and_then(|l| l.note.as_ref()) {
                 bars.suspend(|| eprintln!("{}: note: {note}", model.name));
             }
         }

@@ -79,23 +79,11 @@ pub struct Levels {
     pub records: Vec<usize>,
     pub alive: Vec<Vec<u32>>,
     pub update: Update,
-    /// Where the history stopped, in triangles, when it stopped above a level asked for (which is
-    /// then left out): no vertex left could be removed without a fold or a non-manifold result.
-    pub stopped: Option<usize>,
-}
-
-impl Levels {
-    /// A note for the user when some level asked for is not reached.
-    pub fn note(&self, asked: &[f64]) -> Option<String> {
-        let stopped = self.stopped?;
-        let missing: Vec<String> =
-            asked.iter().filter(|f| !self.fractions.contains(f)).map(|f| f.to_string()).collect();
-        Some(format!(
-            "the simplification stops at {stopped} triangles (no vertex left can be removed without a fold \
-             or a non-manifold result); level(s) {} left out",
-            missing.join(", ")
-        ))
-    }
+    /// What the user should know when a level asked for is not reached (the history stopped
+    /// above it: no vertex left could be removed without a fold or a non-manifold result), or
+    /// repeats the level before it: which levels are drawn coarser than asked and which are left
+    /// out.
+    pub note: Option<String>,
 }
 
 impl Levels {
@@ -136,21 +124,43 @@ impl Frames {
 
     /// `mesh` at each fraction of its triangle count (descending), by `history`'s removals: one
     /// frame a level, framed where the mesh stands. A fraction the history cannot reach gives the
-    /// coarsest level it has.
+    /// coarsest level it has, once ([`Levels::note`] says so).
     pub fn progressive(mesh: &Mesh, history: History, fractions: &[f64], update: Update) -> Frames {
-        // A level the history does not reach would repeat the one before it: it is left out.
+        // A level that would repeat the one before it (the history stopped above both, or two
+        // fractions round to the same removals) is left out; the first level the history stops
+        // above is drawn at the coarsest it reaches. The note says which.
         let mut kept: Vec<(f64, usize)> = Vec::with_capacity(fractions.len());
+        let (mut coarser, mut left_out) = (Vec::new(), Vec::new());
         for &f in fractions {
-            let records = history.records_for((f * mesh.triangle_count() as f64).round() as usize);
-            if kept.last().is_none_or(|&(_, r)| records > r) {
+            let target = (f * mesh.triangle_count() as f64).round() as usize;
+            let records = history.records_for(target);
+            if kept.last().is_some_and(|&(_, r)| records <= r) {
+                left_out.push(f.to_string());
+            } else {
                 kept.push((f, records));
+                if history.triangles_after(records) > target {
+                    coarser.push(f.to_string());
+                }
             }
         }
-        let stopped = (kept.len() < fractions.len()).then(|| history.level(history.records.len()).len());
+        let note = (!coarser.is_empty() || !left_out.is_empty()).then(|| {
+            let mut note = format!(
+                "the simplification stops at {} triangles (no vertex left can be removed without a fold or a \
+                 non-manifold result)",
+                history.triangles_after(history.records.len())
+            );
+            if !coarser.is_empty() {
+                note += &format!("; level {} is drawn with that many", coarser.join(", "));
+            }
+            if !left_out.is_empty() {
+                note += &format!("; level(s) {} left out, as they would repeat the level before", left_out.join(", "));
+            }
+            note
+        });
         let (fractions, records): (Vec<f64>, Vec<usize>) = kept.into_iter().unzip();
         let alive = records.iter().map(|&r| history.level(r)).collect();
         let count = fractions.len();
-        let levels = Levels { history, fractions, records, alive, update, stopped };
+        let levels = Levels { history, fractions, records, alive, update, note };
         Frames {
             frames: vec![mesh.positions.clone(); count],
             clips: vec![(String::new(), 0..count)],

@@ -106,6 +106,12 @@ impl History {
         (0..self.triangles.len() as u32).filter(|&t| alive[t as usize]).collect()
     }
 
+    /// Triangles alive after the first `records` removals: each takes n triangles out and puts
+    /// n − 2 in.
+    pub fn triangles_after(&self, records: usize) -> usize {
+        self.records[..records].iter().fold(self.initial, |count, r| count + r.after.len() - r.before.len())
+    }
+
     /// How many removals bring the mesh to at most `triangles` triangles (all of them if it never
     /// gets there).
     pub fn records_for(&self, triangles: usize) -> usize {
