@@ -15,7 +15,7 @@ mod common;
 use std::collections::{BTreeSet, HashMap};
 use std::path::PathBuf;
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{DVec3, Mat4, Quat, Vec3};
 use triorder::measure::{MeasureOptions, measure};
 use triorder::mesh::gltf::animation::{ClipSelection, read_animated, read_with_rest_pose};
 use triorder::mesh::{Frames, Framing, Mesh, Scene};
@@ -233,7 +233,8 @@ fn tipsify_per_frame_is_sander07_on_each_posed_frame() {
 /// are the same perspective camera at 3r.
 #[test]
 fn evaluation_views_are_not_optimization_views() {
-    let framing = Framing { center: Vec3::new(0.5, -1.0, 2.0), radius: 1.5 };
+    let framing = Framing { center: DVec3::new(0.5, -1.0, 2.0), radius: 1.5 };
+    let center = framing.center.as_vec3();
     let optimized: Vec<Vec3> = icosphere_directions(162).into_iter().map(|d| perspective(framing, d).eye).collect();
     assert_eq!(optimized.len(), 162);
     for seed in [0, 1, 42] {
@@ -242,10 +243,11 @@ fn evaluation_views_are_not_optimization_views() {
         let mut closest = f32::INFINITY;
         for camera in &random {
             assert!(camera.perspective);
-            let offset = camera.eye - framing.center;
-            assert!((offset.length() - 3.0 * framing.radius).abs() < 1e-4 * framing.radius);
+            let offset = camera.eye - center;
+            let radius = framing.radius as f32;
+            assert!((offset.length() - 3.0 * radius).abs() < 1e-4 * radius);
             for eye in &optimized {
-                closest = closest.min(offset.angle_between(*eye - framing.center));
+                closest = closest.min(offset.angle_between(*eye - center));
             }
         }
         eprintln!("seed {seed}: nearest random:300 eye is {:.3}° from an ico:162 eye", closest.to_degrees());
@@ -258,7 +260,7 @@ fn evaluation_views_are_not_optimization_views() {
 /// whose spacing is coarser than the table's 10° cells.
 #[test]
 fn lookup_returns_each_nodes_buffer_from_its_own_direction() {
-    let framing = Framing { center: Vec3::ZERO, radius: 2.0 };
+    let framing = Framing { center: DVec3::ZERO, radius: 2.0 };
     for views in [12u32, 42, 162, 642] {
         let directions = icosphere_directions(views);
         let n = directions.len();

@@ -13,9 +13,15 @@ use triorder::mesh::Framing;
 use triorder::mesh::{Mesh, VertexAttributes, procedural};
 use triorder::raster::{Camera, ViewCounts, ViewSet};
 
-/// Identity camera: world = NDC (x, y in -1..1 map to the image, z in 0..1 is depth).
+/// Identity camera: world = unit frame = NDC (x, y in -1..1 map to the image, z in 0..1 is depth).
 fn ndc_camera() -> Camera {
-    Camera { view_proj: Mat4::IDENTITY, eye: Vec3::new(0.0, 0.0, -1.0), forward: Vec3::Z, perspective: false }
+    Camera {
+        view_proj: Mat4::IDENTITY,
+        framing: Framing::UNIT,
+        eye: Vec3::new(0.0, 0.0, -1.0),
+        forward: Vec3::Z,
+        perspective: false,
+    }
 }
 
 /// A counter-clockwise quad in NDC from pixel (x0, y0) to (x1, y1) at R = 512, at depth z.

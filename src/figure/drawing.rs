@@ -339,7 +339,7 @@ impl Placement {
 }
 
 fn ndc(camera: &views::Camera, p: Vec3) -> Vec2 {
-    let clip = camera.view_proj * p.extend(1.0);
+    let clip = camera.clip(p);
     Vec2::new(clip.x / clip.w, clip.y / clip.w)
 }
 

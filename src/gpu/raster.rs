@@ -9,6 +9,10 @@
 //! 2. A full-screen triangle at depth 1.0 tested GREATER without writes, which passes exactly
 //!    where some fragment left a depth below 1.0: **covered**, by a second query.
 //!
+//! The positions are uploaded in the cameras' unit frame ([`crate::mesh::Framing::to_unit`], the
+//! same f32 values the CPU reference projects), so the counts depend on the shape alone, not on
+//! the model's scale or place, on both backends alike.
+//!
 //! The rules the CPU reference spells out (pixel centres, top-left rule, LESS, clear to 1.0) are
 //! Vulkan's own; the CPU snaps to 8 sub-pixel bits as Vulkan devices do. What can still differ is below the rules:
 //! how a device rounds to its sub-pixel grid and interpolates depth. A fragment whose depth ties
@@ -28,6 +32,7 @@ use glam::{Mat4, Vec3};
 
 use crate::error::{Error, Result};
 use crate::gpu::{self, Gpu};
+use crate::mesh::Framing;
 use crate::raster::cpu::{self, MAX_RESOLUTION};
 use crate::raster::{Camera, RasterBackend, ViewCounts};
 
@@ -139,7 +144,13 @@ impl DeviceRaster {
         let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
         let positions: Vec<Vec3> = corners.iter().map(|&(x, y)| Vec3::new(x, y, 0.5)).collect();
         let quad = [[0, 1, 2], [0, 2, 3]];
-        let camera = Camera { view_proj: Mat4::IDENTITY, eye: Vec3::Z, forward: Vec3::NEG_Z, perspective: false };
+        let camera = Camera {
+            view_proj: Mat4::IDENTITY,
+            framing: Framing::UNIT,
+            eye: Vec3::Z,
+            forward: Vec3::NEG_Z,
+            perspective: false,
+        };
         let counts = self.count(&positions, &[quad, quad].concat(), &[camera], res)?;
         let area = u64::from(res * res);
         let expected = ViewCounts { covered: area, passed: area };
@@ -153,8 +164,25 @@ impl DeviceRaster {
         Ok(())
     }
 
-    /// Uploads the mesh and counts `cameras` on this device, a batch per submission.
+    /// Uploads the mesh, in the unit frame of each run of cameras with one framing (all of them,
+    /// from a view set), and counts `cameras` on this device, a batch per submission.
     fn count(
+        &self,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        cameras: &[Camera],
+        res: u32,
+    ) -> Result<Vec<ViewCounts>> {
+        let mut counts = Vec::with_capacity(cameras.len());
+        for run in cameras.chunk_by(|a, b| a.framing == b.framing) {
+            let unit = run[0].framing.unit_positions(positions);
+            counts.extend(self.count_unit(&unit, triangles, run, res)?);
+        }
+        Ok(counts)
+    }
+
+    /// Counts `cameras` on positions already in their unit frame.
+    fn count_unit(
         &self,
         positions: &[Vec3],
         triangles: &[[u32; 3]],
@@ -307,9 +335,9 @@ impl RasterBackend for GpuRaster {
 /// frames settles it in O(vertices + views); only a camera that fails the sphere test pays the
 /// CPU's exact per-vertex check, which then names the vertex.
 fn check_projection(positions: &[Vec3], cameras: &[Camera], res: u32) -> Result<()> {
-    let framing = crate::mesh::Framing::of(positions);
+    let framing = Framing::of(positions);
     for (i, camera) in cameras.iter().enumerate() {
-        if !camera.frames_sphere(framing.center, framing.radius) {
+        if !camera.frames_sphere(framing) {
             cpu::check_projection(positions, camera, res).map_err(|why| Error::usage(format!("view {i}: {why}")))?;
         }
     }

@@ -205,6 +205,9 @@ impl RenderTimer {
         if !(1..=limit).contains(&res) {
             return Err(Error::usage(format!("resolution {res} is outside 1..={limit} ({})", self.device())));
         }
+        // The model in the camera's unit frame, as the overdraw counts see it: at any scale or
+        // place it covers the same pixels, and the marble has the same number of veins.
+        let positions = &camera.framing.unit_positions(positions);
         let normals = vertex_normals(positions, triangles)?;
         self.gpu.checked("timing a draw", || {
             let device = &self.gpu.device;
@@ -212,7 +215,7 @@ impl RenderTimer {
                 positions.iter().zip(&normals).flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z]).collect();
             let (vertices, index, index_count) = self.gpu.mesh_buffers(&interleaved, triangles)?;
             let mut uniform = camera.view_proj.to_cols_array().to_vec();
-            uniform.extend(camera.eye.extend(1.0).to_array());
+            uniform.extend(camera.unit_eye().extend(1.0).to_array());
             let uniform = self.gpu.buffer_init("view", bytemuck::cast_slice(&uniform), wgpu::BufferUsages::UNIFORM)?;
             let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("view"),

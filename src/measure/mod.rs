@@ -240,7 +240,7 @@ impl<'a> Draws<'a> {
                 lookup.cells()[row..row + cells].iter().for_each(|&b| pick(f, usize::from(b), &mut uses));
             } else {
                 for camera in &cameras {
-                    let b = lookup.buffer(f, camera.eye - framing.center);
+                    let b = lookup.buffer(f, camera.direction());
                     pick(f, b, &mut uses);
                     picks.push(b);
                 }

@@ -9,7 +9,7 @@
 
 use super::{Draws, MeasureOptions, Metric, Name, Value};
 use crate::error::Result;
-use crate::raster::ViewCounts;
+use crate::raster::{ViewCounts, naming_mesh};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OverdrawSummary {
@@ -82,7 +82,10 @@ impl Metric for Overdraw {
         for f in draws.frames.clone() {
             for (b, group) in draws.groups(f) {
                 let cameras: Vec<_> = group.iter().map(|&v| draws.cameras[v]).collect();
-                let counts = draws.raster.count(draws.positions(f), &draws.triangles(b), &cameras, draws.options.res)?;
+                let counts = draws
+                    .raster
+                    .count(draws.positions(f), &draws.triangles(b), &cameras, draws.options.res)
+                    .map_err(|e| naming_mesh(&draws.scene.mesh.name, e))?;
                 for (&v, c) in group.iter().zip(counts) {
                     per_view[(f - first) * views + v] = c;
                 }

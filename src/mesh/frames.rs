@@ -17,7 +17,7 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::Mesh;
@@ -25,22 +25,67 @@ use super::animated::Animated;
 use super::progressive::{History, Update};
 
 /// How a model is framed: bounding-box centre and the largest vertex distance from it.
+///
+/// Both are computed in f64 from the f32 positions, so neither overflows (a radius of 1e25 squares
+/// to 1e50, past f32), underflows (1e-30 squares to 0 in f32) nor loses a far-off-centre mesh's
+/// size to the rounding of its centre. [`Framing::to_unit`] maps a position into the *unit frame*
+/// (centre at the origin, radius 1), where every camera, rasterizer and geometric ordering works:
+/// what they compute then depends on the shape alone, never on where the mesh stands or its
+/// units. The map is exact under scaling by a power of two and under translations that are exact
+/// in f32; any other scale changes the f32 positions themselves by their rounding, and with them
+/// the unit-frame positions by at most about an ulp.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Framing {
-    pub center: Vec3,
-    pub radius: f32,
+    pub center: DVec3,
+    pub radius: f64,
 }
 
 impl Framing {
+    /// The unit frame itself: positions already centred and of radius 1 map to themselves.
+    pub const UNIT: Framing = Framing { center: DVec3::ZERO, radius: 1.0 };
+
     pub fn of(positions: &[Vec3]) -> Framing {
         let (lo, hi) = positions
             .iter()
             .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let center = (lo + hi) * 0.5;
-        let radius = positions.iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
+        let center = if positions.is_empty() { DVec3::ZERO } else { (lo.as_dvec3() + hi.as_dvec3()) * 0.5 };
+        let radius = positions.iter().map(|p| p.as_dvec3().distance(center)).fold(0.0f64, f64::max);
         // A single point or a degenerate mesh still needs a non-empty view volume.
         Framing { center, radius: if radius > 0.0 { radius } else { 1.0 } }
     }
+
+    /// `p` in the unit frame, in f64.
+    pub fn to_unit64(&self, p: Vec3) -> DVec3 {
+        (p.as_dvec3() - self.center) / self.radius
+    }
+
+    /// `p` in the unit frame: centred, divided by the radius in f64, then rounded to f32.
+    pub fn to_unit(&self, p: Vec3) -> Vec3 {
+        self.to_unit64(p).as_vec3()
+    }
+
+    /// Every position in the unit frame ([`Framing::to_unit`]).
+    pub fn unit_positions(&self, positions: &[Vec3]) -> Vec<Vec3> {
+        positions.iter().map(|&p| self.to_unit(p)).collect()
+    }
+
+    /// A point of the unit frame back in world coordinates, rounded to f32.
+    pub fn to_world(&self, p: DVec3) -> Vec3 {
+        (self.center + p * self.radius).as_vec3()
+    }
+}
+
+/// `positions` in their own unit frame (centre at the origin, radius 1; see [`Framing`]): what
+/// every ordering that reads geometry works on, so that it orders a mesh the same wherever it
+/// stands and whatever its units.
+pub fn unit_positions(positions: &[Vec3]) -> Vec<Vec3> {
+    Framing::of(positions).unit_positions(positions)
+}
+
+/// [`unit_positions`] in f64, for orderings that compute in f64.
+pub fn unit_positions64(positions: &[Vec3]) -> Vec<DVec3> {
+    let framing = Framing::of(positions);
+    positions.iter().map(|&p| framing.to_unit64(p)).collect()
 }
 
 /// Positions per frame for one connectivity, grouped by clip.
@@ -103,13 +148,13 @@ impl Frames {
             poses.extend(&clip.frames);
         }
         let mut frames: Vec<Vec<Vec3>> = poses.par_iter().map(|pose| animated.positions(pose)).collect();
-        let mut radius = 0.0f32;
+        let mut radius = 0.0f64;
         for frame in &mut frames {
             let framing = Framing::of(frame);
-            frame.iter_mut().for_each(|p| *p -= framing.center);
+            frame.iter_mut().for_each(|p| *p = (p.as_dvec3() - framing.center).as_vec3());
             radius = radius.max(framing.radius);
         }
-        Frames { frames, clips, framing: Framing { center: Vec3::ZERO, radius }, kind: Kind::Animation }
+        Frames { frames, clips, framing: Framing { center: DVec3::ZERO, radius }, kind: Kind::Animation }
     }
 
     /// A static mesh: one frame, its positions untouched, framed where it stands.
@@ -226,11 +271,32 @@ mod tests {
         };
         let k = Frames::of(&animated);
         for frame in &k.frames {
-            assert_eq!(Framing::of(frame).center, Vec3::ZERO);
+            assert_eq!(Framing::of(frame).center, DVec3::ZERO);
         }
         let scaled: Vec<Vec3> = animated.mesh.positions.iter().map(|&p| 3.0 * p).collect();
-        assert_eq!(k.framing, Framing { center: Vec3::ZERO, radius: Framing::of(&scaled).radius });
+        assert_eq!(k.framing, Framing { center: DVec3::ZERO, radius: Framing::of(&scaled).radius });
         assert!(k.is_animation());
+    }
+
+    #[test]
+    fn framing_holds_at_any_scale_and_the_unit_frame_is_exact() {
+        let shape = [[-1.0, 0.5, 2.0], [3.0, -2.0, 0.25], [0.5, 1.5, -1.0], [0.0, 0.0, 0.0]];
+        let placed = |scale: f64, offset: f64| shape.map(|p| (DVec3::from(p) * scale + offset).as_vec3()).to_vec();
+        let one = Framing::of(&placed(1.0, 0.0));
+        let unit = one.unit_positions(&placed(1.0, 0.0));
+        assert!(unit.iter().all(|p| p.length() <= 1.0 + 1e-6) && unit.iter().any(|p| (p.length() - 1.0).abs() < 1e-6));
+        // Scaled by powers of two, or moved by a translation f32 holds exactly: the same bits.
+        for (scale, offset) in [((-120f64).exp2(), 0.0), (120f64.exp2(), 0.0), (1.0, 4096.0), (0.5, -1e6)] {
+            let positions = placed(scale, offset);
+            let framing = Framing::of(&positions);
+            assert_eq!(framing.radius, one.radius * scale, "×{scale} +{offset}");
+            assert_eq!(framing.unit_positions(&positions), unit, "×{scale} +{offset}");
+        }
+        // Whose radius squared leaves f32 (1e-60 underflows, 1e50 overflows): still framed.
+        for scale in [1e-30, 1e25] {
+            let framing = Framing::of(&placed(scale, 0.0));
+            assert!((framing.radius / (one.radius * scale) - 1.0).abs() < 1e-6, "×{scale}: {framing:?}");
+        }
     }
 
     #[test]

@@ -7,6 +7,8 @@
 use std::collections::HashSet;
 use std::fmt;
 
+use glam::Vec3;
+
 use crate::mesh::Mesh;
 use crate::mesh::topology::Topology;
 
@@ -20,7 +22,8 @@ pub struct MeshReport {
     pub shared_vertices: usize,
     /// Triangles repeating a vertex index.
     pub repeated_index: usize,
-    /// Triangles with three distinct indices but zero area (collinear or coincident positions).
+    /// Triangles with three distinct indices but zero area (collinear or coincident positions),
+    /// decided exactly on the stored coordinates ([`has_zero_area`]), so at any scale.
     pub zero_area: usize,
     /// Extra copies of a triangle over the same three welded vertices (any order or winding).
     pub duplicates: usize,
@@ -41,8 +44,7 @@ impl MeshReport {
             if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
                 repeated_index += 1;
             } else {
-                let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-                zero_area += usize::from((b - a).cross(c - a) == glam::Vec3::ZERO);
+                zero_area += usize::from(has_zero_area(tri.map(|v| mesh.positions[v as usize])));
             }
             let mut key = tri.map(|v| topology.weld[v as usize]);
             key.sort_unstable();
@@ -85,6 +87,42 @@ impl MeshReport {
     }
 }
 
+/// Whether the triangle `[a, b, c]` has exactly zero area: its corners collinear, or two of them
+/// at one point. Its cross product (b − a) × (c − a) is evaluated exactly: each component, a 2×2
+/// determinant of the coordinates, expands into six products of two f32 coordinates, each exact
+/// in f64 (48 significant bits, no overflow or underflow for any f32), summed without rounding
+/// ([`exact_sum_is_zero`]). Computed in f32, the cross product of a proper triangle of a 1e-30
+/// mesh underflowed to zero (and every triangle was reported degenerate); a threshold relative to
+/// the mesh's size would instead call thin but proper triangles degenerate.
+pub fn has_zero_area([a, b, c]: [Vec3; 3]) -> bool {
+    // The determinant of rows (a_u, a_v, 1), (b_u, b_v, 1), (c_u, c_v, 1) over the axes u, v: the
+    // component of the cross product along the third axis.
+    let orient = |u: usize, v: usize| {
+        let p = |x: Vec3, y: Vec3| f64::from(x[u]) * f64::from(y[v]);
+        [p(a, b), -p(b, a), p(b, c), -p(c, b), p(c, a), -p(a, c)]
+    };
+    exact_sum_is_zero(&orient(1, 2)) && exact_sum_is_zero(&orient(2, 0)) && exact_sum_is_zero(&orient(0, 1))
+}
+
+/// Whether `terms` (finite, far from overflow) sum to exactly zero: they are added into a
+/// nonoverlapping expansion by error-free two-sums (Shewchuk 1997, "Adaptive precision
+/// floating-point arithmetic and fast robust geometric predicates", Grow-Expansion), whose
+/// components then sum exactly to the terms' sum, and which is zero only when every component is.
+fn exact_sum_is_zero(terms: &[f64]) -> bool {
+    let mut expansion: Vec<f64> = Vec::with_capacity(terms.len());
+    for &term in terms {
+        let mut q = term;
+        for e in &mut expansion {
+            let s = q + *e;
+            let b = s - q;
+            let error = (q - (s - b)) + (*e - b);
+            (q, *e) = (s, error);
+        }
+        expansion.push(q);
+    }
+    expansion.iter().all(|&e| e == 0.0)
+}
+
 impl fmt::Display for MeshReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
@@ -103,7 +141,6 @@ impl fmt::Display for MeshReport {
 mod tests {
     use super::*;
     use crate::mesh::VertexAttributes;
-    use glam::Vec3;
 
     #[test]
     fn irregularities_are_counted_not_dropped() {
@@ -131,5 +168,26 @@ mod tests {
         let soup = soup.unwrap();
         let text = MeshReport::new(&soup, &Topology::new(&soup)).to_string();
         assert!(text.contains("unindexed"), "{text}");
+    }
+
+    #[test]
+    fn zero_area_is_exact_at_any_scale() {
+        let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        for s in [1e-38f32, 1e-30, 1e-25, 1.0, 1e20, 1e30, 1e38] {
+            // A proper right triangle: its f32 cross product underflows below 1e-23 and overflows
+            // above 1e19, its exact one does neither.
+            assert!(!has_zero_area([v(0., 0., 0.), v(s, 0., 0.), v(0., s, 0.)]), "{s}");
+            assert!(!has_zero_area([v(s, s, s), v(2. * s, s, -s), v(s, 3. * s, s)]), "{s}");
+            // Collinear and coincident corners, along a diagonal and off the axes.
+            assert!(has_zero_area([v(s, s, s), v(2. * s, 2. * s, 2. * s), v(-s, -s, -s)]), "{s}");
+            assert!(has_zero_area([v(0., s, 0.), v(0., s, 0.), v(s, 0., s)]), "{s}");
+        }
+        // Far from the origin, a sliver one ulp off the line is proper; on it, degenerate.
+        let (a, b) = (v(1e7, 0., 5.), v(1e7 + 2., 2., 5.));
+        assert!(!has_zero_area([a, b, v(1e7 + 1., 2., 5.)]));
+        assert!(has_zero_area([a, b, v(1e7 + 1., 1., 5.)]));
+        // Terms that cancel only exactly: 2^60 + 1 − 2^60 − 1 with the ones lost in any f64 sum.
+        assert!(exact_sum_is_zero(&[2f64.powi(60), 1.0, -(2f64.powi(60)), -1.0]));
+        assert!(!exact_sum_is_zero(&[2f64.powi(60), 1.0, -(2f64.powi(60))]));
     }
 }

@@ -3,11 +3,20 @@
 //! view, poor vertex locality. The direction points from the model towards the eye, as figure
 //! views do; triangles are sorted by decreasing centroid projection on it (stable, so ties keep
 //! the input order).
+//!
+//! The depths are taken from the mesh's centre ([`Framing`]) in f64, each triangle's three corner
+//! depths summed in increasing order, so the order does not depend on where the mesh stands or
+//! its units: in f32 world coordinates a mesh far from the origin summed its offset into every
+//! depth and lost the differences between them to rounding, and a 1e-30 or 1e30 one rounded
+//! differently. They are not divided by the radius (the unit frame's scale, which would not
+//! change their order): that rounding would break exact ties, and real meshes have them (two
+//! triangles of `spot` whose corner heights sum to the same six-decimal value in the file).
 
 use glam::Vec3;
 
 use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
+use crate::mesh::Framing;
 use crate::mesh::Scene;
 
 const COMPONENT: ParamKind = ParamKind::Float { min: -1e6, max: 1e6 };
@@ -43,10 +52,16 @@ impl Ordering for FrontToBack {
             Error::usage("method `front-to-back`: the view direction x, y, z must not be zero".to_string())
         })?;
         let mesh = &scene.mesh;
-        let depth: Vec<f32> = mesh
+        let (direction, center) = (direction.as_dvec3(), Framing::of(&mesh.positions).center);
+        let vertex_depth: Vec<f64> = mesh.positions.iter().map(|p| (p.as_dvec3() - center).dot(direction)).collect();
+        let depth: Vec<f64> = mesh
             .triangles
             .iter()
-            .map(|t| t.iter().map(|&v| mesh.positions[v as usize].dot(direction)).sum::<f32>())
+            .map(|t| {
+                let mut d = t.map(|v| vertex_depth[v as usize]);
+                d.sort_by(f64::total_cmp);
+                d.iter().sum()
+            })
             .collect();
         let mut order: Order = (0..mesh.triangle_count() as u32).collect();
         order.sort_by(|&a, &b| depth[b as usize].total_cmp(&depth[a as usize]));

@@ -30,6 +30,12 @@
 //! `mode=joint` one set of k buffers for all frames of all clips. Buffers that end with no node
 //! are dropped, so the buffer count is what the lookup can pick. A static mesh is an animation
 //! of one frame, and the result is then k view-dependent buffers.
+//!
+//! Every distance, direction and rasterization is taken in the unit frame the cameras see the
+//! keyframes in (centred, divided by the animation's radius, in f64: [`crate::mesh::Framing`]),
+//! so the buffers and the lookup do not depend on the model's units or place. In world
+//! coordinates the f32 distances of a 1e-30 model underflowed to zero (every patch tied), and a
+//! 1e30 model was refused as needing clipping.
 
 use std::ops::Range;
 use std::time::Instant;
@@ -44,6 +50,7 @@ use super::{Clustered, Lookup, Method, Ordering, Orders, ParamInfo, ParamKind, P
 use crate::error::{Error, Result};
 use crate::mesh::{Frames, Scene};
 use crate::raster::cpu::{Fragment, fragments};
+use crate::raster::naming_mesh;
 use crate::raster::views::{Camera, icosphere_directions, perspective};
 
 const CLUSTERS: ParamInfo = ParamInfo {
@@ -137,7 +144,13 @@ impl Ordering for Hs17 {
         clock.lap("patches");
         let directions = icosphere_directions(self.views);
         let cameras: Vec<Camera> = directions.iter().map(|&d| perspective(keyframes.framing, d)).collect();
-        let scene = Nodes { triangles: &scene.mesh.triangles, keyframes, patches: &patches, cameras: &cameras };
+        let scene = Nodes {
+            name: &scene.mesh.name,
+            triangles: &scene.mesh.triangles,
+            keyframes,
+            patches: &patches,
+            cameras: &cameras,
+        };
         let groups: Vec<Range<usize>> = if self.joint {
             std::iter::once(0..keyframes.len()).collect()
         } else {
@@ -172,6 +185,8 @@ impl Ordering for Hs17 {
 
 /// What every k-means run shares: the (keyframe, viewpoint) nodes and the patches.
 struct Nodes<'a> {
+    /// The mesh's name, for errors.
+    name: &'a str,
     triangles: &'a [[u32; 3]],
     keyframes: &'a Frames,
     patches: &'a Clustered,
@@ -210,9 +225,9 @@ impl Hs17 {
         clock.lap("centroids");
 
         let mut buffers: Vec<Clustered> = self
-            .initial_viewpoints(views, scene.cameras, scene.keyframes.framing.center)
+            .initial_viewpoints(views, scene.cameras)
             .iter()
-            .map(|&v| scene.buffer(&sort_by_key(&average, |c| c.distance(scene.cameras[v].eye))))
+            .map(|&v| scene.buffer(&sort_by_key(&average, |c| c.distance(scene.cameras[v].unit_eye()))))
             .collect();
         let nodes = rasterize_nodes(scene, frames.clone(), self.res)?;
         clock.lap("rasterization");
@@ -237,7 +252,7 @@ impl Hs17 {
                     .into_par_iter()
                     .map(|p| {
                         let at = &centroids[p * frame_count..(p + 1) * frame_count];
-                        members.iter().map(|&n| scene.cameras[n % views].eye.distance(at[n / views])).sum()
+                        members.iter().map(|&n| scene.cameras[n % views].unit_eye().distance(at[n / views])).sum()
                     })
                     .collect();
                 *buffer = scene.buffer(&sort_by_key(&d, |&d| d));
@@ -247,12 +262,12 @@ impl Hs17 {
     }
 
     /// `clusters` distinct viewpoint indices, drawn with the separation rule (directions seen from
-    /// the framing `center`).
-    fn initial_viewpoints(&self, views: usize, cameras: &[Camera], center: Vec3) -> Vec<usize> {
+    /// the framing's centre).
+    fn initial_viewpoints(&self, views: usize, cameras: &[Camera]) -> Vec<usize> {
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(self.seed);
         let k = self.clusters.min(views);
         let mut chosen: Vec<usize> = Vec::with_capacity(k);
-        let direction = |v: usize| (cameras[v].eye - center).normalize();
+        let direction = |v: usize| cameras[v].direction();
         while chosen.len() < k {
             let mut pick = rng.random_range(0..views);
             for _ in 0..SEPARATION_TRIES {
@@ -278,8 +293,12 @@ fn sort_by_key<T>(keys: &[T], key: impl Fn(&T) -> f32) -> Vec<usize> {
     sorted
 }
 
-/// Per patch, per frame of `frames`: the mean of its triangles' corners.
+/// Per patch, per frame of `frames`: the mean of its triangles' corners, in the unit frame the
+/// cameras see the keyframes in (centred, divided by the animation's radius, in f64), so the
+/// distances to the viewpoints neither underflow nor overflow in f32 and do not depend on the
+/// model's scale or place.
 fn patch_centroids(scene: &Nodes, frames: Range<usize>) -> Vec<Vec3> {
+    let framing = scene.keyframes.framing;
     let starts = &scene.patches.starts;
     (0..scene.patch_count())
         .into_par_iter()
@@ -288,7 +307,10 @@ fn patch_centroids(scene: &Nodes, frames: Range<usize>) -> Vec<Vec3> {
             let corners = 3.0 * tris.len() as f32;
             frames.clone().map(move |f| {
                 let positions = &scene.keyframes.frames[f];
-                tris.iter().flat_map(|&t| scene.triangles[t as usize]).map(|v| positions[v as usize]).sum::<Vec3>()
+                tris.iter()
+                    .flat_map(|&t| scene.triangles[t as usize])
+                    .map(|v| framing.to_unit(positions[v as usize]))
+                    .sum::<Vec3>()
                     / corners
             })
         })
@@ -305,7 +327,8 @@ fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<Vec<
             || (Vec::new(), Vec::new()),
             |(fragments_, slots), n| {
                 let (frame, camera) = (frames.start + n / views, &scene.cameras[n % views]);
-                fragments(&scene.keyframes.frames[frame], scene.triangles, camera, res, fragments_)?;
+                fragments(&scene.keyframes.frames[frame], scene.triangles, camera, res, fragments_)
+                    .map_err(|e| naming_mesh(scene.name, e))?;
                 Ok(Contested::of(fragments_, res, slots))
             },
         )

@@ -23,6 +23,7 @@ use glam::{DVec3, Vec3};
 use super::tipsify::{FIFO_CACHE, tipsify};
 use super::{Clustered, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
+use crate::mesh::frames::unit_positions64;
 use crate::mesh::topology::Csr;
 use crate::mesh::{Mesh, Scene};
 
@@ -148,14 +149,17 @@ impl Fifo {
 }
 
 /// Indices of `clusters` (lists of triangle ids) in dot-rule order: decreasing
-/// `(C(P) − C(M)) · N(P)`, stable.
+/// `(C(P) − C(M)) · N(P)`, stable. Computed in f64 on the positions in their unit frame
+/// ([`unit_positions64`]), where the keys are the world keys divided by the radius (the order is
+/// the same) and the same bits wherever the mesh stands and whatever its units.
 pub(crate) fn dot_rule_sort(positions: &[Vec3], triangles: &[[u32; 3]], clusters: &[&[u32]]) -> Vec<usize> {
+    let positions = unit_positions64(positions);
     // Per cluster: Σ area·centroid, Σ area, Σ area-weighted normal (twice the area, the cross product).
     let sums: Vec<(DVec3, f64, DVec3)> = clusters
         .iter()
         .map(|tris| {
             tris.iter().fold((DVec3::ZERO, 0.0, DVec3::ZERO), |(c, a, n), &t| {
-                let [p, q, r] = triangles[t as usize].map(|v| positions[v as usize].as_dvec3());
+                let [p, q, r] = triangles[t as usize].map(|v| positions[v as usize]);
                 let cross = (q - p).cross(r - p);
                 let area = cross.length();
                 (c + area * (p + q + r) / 3.0, a + area, n + cross)

@@ -1,9 +1,12 @@
 //! The CPU rasterizer: the project's reference for overdraw counts.
 //!
 //! Rules, chosen to be exact, deterministic and what a Vulkan GPU does with one sample per pixel:
-//! - Vertices go through the camera's world → clip transform, the perspective divide and the
-//!   viewport transform to an R×R image with y up, then are snapped to 1/256 pixel (8 sub-pixel
-//!   bits, Vulkan's usual `subPixelPrecisionBits`). Everything after the snap is integer-exact.
+//! - Vertices are mapped into the camera's unit frame (centred on the model and divided by its
+//!   radius, in f64: [`Camera::clip`]), so the counts do not depend on the model's scale or
+//!   place, then go through the camera's unit frame → clip transform, the perspective divide and
+//!   the viewport transform to an R×R image with y up, then are snapped to 1/256 pixel (8
+//!   sub-pixel bits, Vulkan's usual `subPixelPrecisionBits`). Everything after the snap is
+//!   integer-exact.
 //! - Back faces are culled geometrically: a triangle is drawn only if its snapped projection is
 //!   counter-clockwise, i.e. its counter-clockwise normal points toward the viewer. Zero-area
 //!   projections are culled too.
@@ -57,17 +60,29 @@ impl RasterBackend for CpuRaster {
         res: u32,
     ) -> Result<Vec<ViewCounts>> {
         check_resolution(res)?;
-        cameras
-            .par_iter()
-            .enumerate()
-            .map_init(
-                || (Vec::new(), Vec::new()),
-                |(screen, depth), (i, camera)| {
-                    project(positions, camera, res, screen).map_err(|why| Error::usage(format!("view {i}: {why}")))?;
-                    Ok(draw(screen, triangles, res, depth, |_| {}))
-                },
-            )
-            .collect()
+        // The positions go into the unit frame once per run of cameras with one framing (all of
+        // them, from a view set), the same f32 values the GPU backend uploads. A failure names
+        // the first view that fails, whichever thread met one first.
+        let mut counts = Vec::with_capacity(cameras.len());
+        for run in cameras.chunk_by(|a, b| a.framing == b.framing) {
+            let (first, unit) = (counts.len(), run[0].framing.unit_positions(positions));
+            let run: Vec<ViewCounts> = run
+                .par_iter()
+                .enumerate()
+                .map_init(
+                    || (Vec::new(), Vec::new()),
+                    |(screen, depth), (i, camera)| {
+                        project(&unit, camera, res, screen)
+                            .map_err(|why| Error::usage(format!("view {}: {why}", first + i)))?;
+                        Ok(draw(screen, triangles, res, depth, |_| {}))
+                    },
+                )
+                .collect::<Vec<Result<ViewCounts>>>()
+                .into_iter()
+                .collect::<Result<_>>()?;
+            counts.extend(run);
+        }
+        Ok(counts)
     }
 }
 
@@ -77,7 +92,7 @@ impl RasterBackend for CpuRaster {
 pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Camera, res: u32) -> Result<Vec<u32>> {
     check_resolution(res)?;
     let mut screen = Vec::new();
-    project(positions, camera, res, &mut screen).map_err(Error::usage)?;
+    project(&camera.framing.unit_positions(positions), camera, res, &mut screen).map_err(Error::usage)?;
     let mut seen = vec![u32::MAX; res as usize * res as usize];
     draw(&screen, triangles, res, &mut Vec::new(), |f| {
         if f.passed {
@@ -93,7 +108,7 @@ pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Ca
 pub fn shaded_per_pixel(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Camera, res: u32) -> Result<Vec<u32>> {
     check_resolution(res)?;
     let mut screen = Vec::new();
-    project(positions, camera, res, &mut screen).map_err(Error::usage)?;
+    project(&camera.framing.unit_positions(positions), camera, res, &mut screen).map_err(Error::usage)?;
     let mut shaded = vec![0u32; res as usize * res as usize];
     draw(&screen, triangles, res, &mut Vec::new(), |f| {
         if f.passed {
@@ -126,7 +141,7 @@ pub fn fragments(
 ) -> Result<()> {
     check_resolution(res)?;
     let mut screen = Vec::new();
-    project(positions, camera, res, &mut screen).map_err(Error::usage)?;
+    project(&camera.framing.unit_positions(positions), camera, res, &mut screen).map_err(Error::usage)?;
     out.clear();
     draw(&screen, triangles, res, &mut Vec::new(), |f| out.push(f));
     Ok(())
@@ -135,7 +150,7 @@ pub fn fragments(
 /// Whether `camera` sees every vertex of `positions` without clipping and without projecting far
 /// off screen: the condition [`CpuRaster`] refuses a view for, with the same message.
 pub fn check_projection(positions: &[Vec3], camera: &Camera, res: u32) -> std::result::Result<(), String> {
-    project(positions, camera, res, &mut Vec::new())
+    project(&camera.framing.unit_positions(positions), camera, res, &mut Vec::new())
 }
 
 /// An image side the rasterizer can draw: 1 to [`MAX_RESOLUTION`] pixels.
@@ -147,19 +162,16 @@ fn check_resolution(res: u32) -> Result<()> {
     }
 }
 
-/// Projects and snaps every vertex into `out`. Fails if a vertex lies outside the depth range
-/// (it would need clipping, which the view sets are framed never to need) or far off screen.
-fn project(
-    positions: &[Vec3],
-    camera: &Camera,
-    res: u32,
-    out: &mut Vec<ScreenVertex>,
-) -> std::result::Result<(), String> {
+/// Projects and snaps every vertex of `unit` (positions already in the camera's unit frame,
+/// [`crate::mesh::Framing::unit_positions`]) into `out`. Fails if a vertex lies outside the depth
+/// range (it would need clipping, which the view sets are framed never to need) or far off
+/// screen.
+fn project(unit: &[Vec3], camera: &Camera, res: u32, out: &mut Vec<ScreenVertex>) -> std::result::Result<(), String> {
     let scale = 0.5 * res as f32 * ONE as f32;
     let limit = (8 * i64::from(res) * ONE) as f32;
     out.clear();
-    out.reserve(positions.len());
-    for (i, p) in positions.iter().enumerate() {
+    out.reserve(unit.len());
+    for (i, p) in unit.iter().enumerate() {
         let clip = camera.view_proj * p.extend(1.0);
         let ndc = clip.truncate() / clip.w;
         if !(clip.w > 0.0 && (0.0..=1.0).contains(&ndc.z)) {

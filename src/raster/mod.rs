@@ -6,8 +6,20 @@ pub mod views;
 
 use glam::Vec3;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 pub use views::{Camera, ViewSet};
+
+/// `error`, raised while drawing the mesh named `mesh`, as a problem of that mesh: a view its
+/// geometry cannot be drawn from (a vertex that would need clipping or projects far off screen,
+/// which the view sets are framed never to need) names the file, as every input error does.
+/// The backends report those as usage errors, since they do not know the mesh; others pass
+/// unchanged.
+pub fn naming_mesh(mesh: &str, error: Error) -> Error {
+    match error {
+        Error::Usage(problem) => Error::input(mesh, problem),
+        other => other,
+    }
+}
 
 /// What one view of one draw order produced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

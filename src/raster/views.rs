@@ -14,22 +14,37 @@
 //! convention) with the near and far planes outside the bounding sphere, so no triangle is ever
 //! clipped (glam's right-handed view with `directx` projections: NDC y up, z in 0..1, as wgpu).
 //! The image's "up" is world +Y, or +Z when the view direction is within ~8° of ±Y.
+//!
+//! A camera sees the model in its *unit frame* ([`Framing::to_unit`]: centred and divided by r,
+//! in f64): its matrix is built for the unit sphere at the origin, and every rasterizer maps the
+//! positions into the unit frame before the matrix. So the counts depend on the shape alone: a
+//! mesh at 1e-30 or 1e25 scale, or far from the origin, is drawn as it would be at unit size
+//! around the origin. Built from world coordinates in f32 instead, a 1e-30 mesh squared its
+//! radius to zero (and was drawn as a point: "no visible faces"), a 1e25 one to infinity (and
+//! was refused as needing clipping), and one far off-centre lost its size to the rounding of
+//! the translation.
 
 use std::fmt;
 use std::str::FromStr;
 
 use glam::camera::rh::{proj::directx, view::look_at_mat4};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 use rand::{Rng, SeedableRng};
 
 use crate::error::{Error, Result};
 use crate::mesh::Framing;
 
-/// One view: a world → clip transform (depth 0..1, y up) and where the eye is.
+/// One view: where the model is framed, a unit frame → clip transform (depth 0..1, y up) and
+/// where the eye is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
+    /// Unit frame → clip: applied to positions after `framing` has mapped them into the unit
+    /// frame ([`Camera::clip`]).
     pub view_proj: Mat4,
-    /// The viewpoint (for orthographic views: a point on the axis, outside the bounding sphere).
+    /// The framing the camera was made for: world positions → unit frame, in f64.
+    pub framing: Framing,
+    /// The viewpoint in world coordinates, rounded to f32 (for orthographic views: a point on
+    /// the axis, outside the bounding sphere).
     pub eye: Vec3,
     /// Unit vector from the eye toward the model centre.
     pub forward: Vec3,
@@ -37,10 +52,34 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// True when the sphere (`center`, `radius`) lies inside this camera's depth range and projects
-    /// well within the area the rasterizers accept (|NDC x|, |NDC y| ≤ 14), so no vertex inside it
-    /// can need clipping. Each condition is a plane a·(p, 1) ≥ 0 made from rows of the matrix.
-    pub fn frames_sphere(&self, center: Vec3, radius: f32) -> bool {
+    /// The clip coordinates of the world position `p`: mapped into the unit frame in f64, then
+    /// through [`Camera::view_proj`] in f32, as every rasterizer does.
+    pub fn clip(&self, p: Vec3) -> Vec4 {
+        self.view_proj * self.framing.to_unit(p).extend(1.0)
+    }
+
+    /// The eye in the unit frame: its direction from the centre, at the camera's distance (2 for
+    /// orthographic views, 3 for perspective ones).
+    pub fn unit_eye(&self) -> Vec3 {
+        -self.forward * if self.perspective { 3.0 } else { 2.0 }
+    }
+
+    /// Unit vector from the model centre toward the eye: exact, whatever the scale and place of
+    /// the model (`eye − centre` in f32 is not, far from the origin).
+    pub fn direction(&self) -> Vec3 {
+        -self.forward
+    }
+
+    /// True when the sphere `sphere` (world coordinates) lies inside this camera's depth range
+    /// and projects well within the area the rasterizers accept (|NDC x|, |NDC y| ≤ 14), so no
+    /// vertex inside it can need clipping. The sphere is taken into the unit frame in f64; each
+    /// condition is a plane a·(p, 1) ≥ 0 made from rows of the matrix.
+    pub fn frames_sphere(&self, sphere: Framing) -> bool {
+        let center = ((sphere.center - self.framing.center) / self.framing.radius).as_vec3();
+        let radius = (sphere.radius / self.framing.radius) as f32;
+        if !(center.is_finite() && radius.is_finite()) {
+            return false;
+        }
         let m = self.view_proj;
         let (x, y, z, w) = (m.row(0), m.row(1), m.row(2), m.row(3));
         [z, w - z, 14.0 * w - x, 14.0 * w + x, 14.0 * w - y, 14.0 * w + y].iter().all(|plane| {
@@ -138,23 +177,27 @@ fn up_for(direction: Vec3) -> Vec3 {
     if direction.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y }
 }
 
-/// Orthographic camera looking at the centre from `direction` (unit vector centre → eye).
+/// Orthographic camera looking at the centre from `direction` (unit vector centre → eye), at
+/// twice the radius: built in the unit frame ([`Camera`]).
 pub fn orthographic(framing: Framing, direction: Vec3) -> Camera {
-    let r = framing.radius;
-    let eye = framing.center + direction * (2.0 * r);
-    let view = look_at_mat4(eye, framing.center, up_for(direction));
-    let proj = directx::orthographic(-r, r, -r, r, 0.5 * r, 3.5 * r);
-    Camera { view_proj: proj * view, eye, forward: -direction, perspective: false }
+    let view = look_at_mat4(direction * 2.0, Vec3::ZERO, up_for(direction));
+    let proj = directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.5, 3.5);
+    camera(framing, direction, 2.0, proj * view, false)
 }
 
 /// Perspective camera at 3r from the centre along `direction`, fitting the bounding sphere.
 pub fn perspective(framing: Framing, direction: Vec3) -> Camera {
-    let r = framing.radius;
-    let eye = framing.center + direction * (3.0 * r);
-    let view = look_at_mat4(eye, framing.center, up_for(direction));
+    let view = look_at_mat4(direction * 3.0, Vec3::ZERO, up_for(direction));
     let fov_y = 2.0 * (1.0f32 / 3.0).asin();
-    let proj = directx::perspective(fov_y, 1.0, 1.0 * r, 5.0 * r);
-    Camera { view_proj: proj * view, eye, forward: -direction, perspective: true }
+    let proj = directx::perspective(fov_y, 1.0, 1.0, 5.0);
+    camera(framing, direction, 3.0, proj * view, true)
+}
+
+/// A camera of `framing` at `distance` radii along `direction`, seeing the unit frame through
+/// `view_proj`.
+fn camera(framing: Framing, direction: Vec3, distance: f64, view_proj: Mat4, perspective: bool) -> Camera {
+    let eye = framing.to_world(direction.as_dvec3() * distance);
+    Camera { view_proj, framing, eye, forward: -direction, perspective }
 }
 
 /// Uniform direction on the unit sphere (z uniform in [-1, 1], azimuth uniform).
@@ -230,6 +273,7 @@ pub fn icosphere_directions(n: u32) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
 
     #[test]
     fn icosphere_counts_nest_and_are_unit() {
@@ -250,12 +294,12 @@ mod tests {
 
     #[test]
     fn cameras_frame_the_bounding_sphere() {
-        let framing = Framing { center: Vec3::new(1.0, 2.0, 3.0), radius: 2.0 };
+        let framing = Framing { center: DVec3::new(1.0, 2.0, 3.0), radius: 2.0 };
         for set in ["axis6", "ico:42", "random:50"] {
             for cam in set.parse::<ViewSet>().unwrap().cameras(framing, 7) {
                 // Sphere points project inside the unit square and strictly inside the depth range.
                 for d in icosphere_directions(162) {
-                    let clip = cam.view_proj * (framing.center + d * framing.radius).extend(1.0);
+                    let clip = cam.clip(framing.to_world(d.as_dvec3()));
                     let ndc = clip.truncate() / clip.w;
                     assert!(ndc.x.abs() <= 1.0001 && ndc.y.abs() <= 1.0001, "{set}: {ndc}");
                     assert!(ndc.z > 0.0 && ndc.z < 1.0, "{set}: {ndc}");
@@ -266,19 +310,19 @@ mod tests {
 
     #[test]
     fn framed_spheres_pass_and_clipped_ones_fail() {
-        let framing = Framing { center: Vec3::new(1.0, 2.0, 3.0), radius: 2.0 };
+        let framing = Framing { center: DVec3::new(1.0, 2.0, 3.0), radius: 2.0 };
         for set in ["axis6", "ico:42", "random:50"] {
             for cam in set.parse::<ViewSet>().unwrap().cameras(framing, 7) {
-                assert!(cam.frames_sphere(framing.center, framing.radius), "{set}");
+                assert!(cam.frames_sphere(framing), "{set}");
                 // Reaching the eye crosses the near plane.
-                assert!(!cam.frames_sphere(framing.center, 2.2 * framing.radius), "{set}");
+                assert!(!cam.frames_sphere(Framing { radius: 2.2 * framing.radius, ..framing }), "{set}");
             }
         }
     }
 
     #[test]
     fn random_views_are_seeded() {
-        let f = Framing { center: Vec3::ZERO, radius: 1.0 };
+        let f = Framing::UNIT;
         let a = ViewSet::Random(5).cameras(f, 1);
         assert_eq!(a, ViewSet::Random(5).cameras(f, 1));
         assert_ne!(a, ViewSet::Random(5).cameras(f, 2));

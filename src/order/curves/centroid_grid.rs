@@ -7,10 +7,15 @@
 //! occupied cell holds about one triangle: a surface crosses a cube of side `s` over an area of
 //! about s², so s = √(total area / triangle count). Finer cells would only leave more empty cells
 //! for the curve to skip; coarser ones would leave more triangles in arbitrary (id) order.
+//!
+//! Everything is computed in f64 on the positions in the mesh's unit frame
+//! ([`crate::mesh::frames::unit_positions64`]), so the cells, which the grid scales with the mesh,
+//! are the same bits wherever the mesh stands and whatever its units.
 
 use glam::DVec3;
 
 use crate::mesh::Mesh;
+use crate::mesh::frames::unit_positions64;
 use crate::order::Order;
 
 /// Most cells along one axis: 2^20, so three axes fit a 64-bit curve index.
@@ -26,7 +31,8 @@ pub(crate) struct CentroidGrid {
 
 impl CentroidGrid {
     pub fn new(mesh: &Mesh) -> CentroidGrid {
-        let corner = |v: u32| mesh.positions[v as usize].as_dvec3();
+        let positions = unit_positions64(&mesh.positions);
+        let corner = |v: u32| positions[v as usize];
         let centroids: Vec<DVec3> =
             mesh.triangles.iter().map(|t| (corner(t[0]) + corner(t[1]) + corner(t[2])) / 3.0).collect();
         let area: f64 = mesh

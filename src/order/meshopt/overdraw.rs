@@ -2,10 +2,19 @@
 //! its take on Sander, Nehab & Barczak 2007 §4-5 (linear clustering at cache-flush boundaries,
 //! then clusters sorted by the dot rule). Its threshold differs from the paper's λ: a cluster is
 //! cut once its local ACMR is within `threshold` × the global ACMR.
+//!
+//! meshoptimizer is given the positions in the mesh's unit frame
+//! ([`crate::mesh::frames::unit_positions`]), not as loaded: it computes its sort keys in f32, so
+//! at 1e-30 scale its triangle normals underflow to zero, at 1e30 its areas overflow, and far from
+//! the origin its centroids lose their offsets to rounding; each gave another order for the same
+//! shape.
+
+use glam::Vec3;
 
 use super::order_from_index_buffer;
 use crate::error::Result;
 use crate::mesh::Scene;
+use crate::mesh::frames::unit_positions;
 use crate::order::{Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 
 const THRESHOLD: ParamInfo = ParamInfo {
@@ -37,7 +46,10 @@ impl Ordering for MeshoptOverdraw {
     fn order(&self, scene: &Scene) -> Result<Orders> {
         let mesh = &scene.mesh;
         let mut indices = meshopt::optimize_vertex_cache(&mesh.index_buffer(), mesh.vertex_count());
-        meshopt::optimize_overdraw_in_place(&mut indices, &mesh.meshopt_positions(), self.threshold);
+        let unit = unit_positions(&mesh.positions);
+        let positions = meshopt::VertexDataAdapter::new(meshopt::typed_to_bytes(&unit), size_of::<Vec3>(), 0)
+            .expect("Vec3 slices are a whole number of 12-byte vertices");
+        meshopt::optimize_overdraw_in_place(&mut indices, &positions, self.threshold);
         order_from_index_buffer(mesh, &scene.topology, &indices).map(Orders::from)
     }
 }

@@ -28,7 +28,7 @@ use super::{Clustered, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Pa
 use crate::error::Result;
 use crate::mesh::Framing;
 use crate::mesh::{Mesh, Scene};
-use crate::raster::ViewSet;
+use crate::raster::{ViewSet, naming_mesh};
 
 const CLUSTERS: ParamInfo = ParamInfo {
     name: "clusters",
@@ -108,7 +108,7 @@ impl Ordering for Nehab {
         let triangles = mesh.triangles_in_order(&local.order);
         let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &local.starts };
         let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
-        let graph = one_pass(draw, &cameras, self.res)?;
+        let graph = one_pass(draw, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?;
         let sequence = greedy_order(clusters.count, &graph.arcs());
         Ok(Clustered::concat(sequence.iter().map(|&c| inner_orders[c as usize].as_slice())).into())
     }

@@ -79,6 +79,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::mesh::Mesh;
+use crate::mesh::frames::unit_positions;
 use crate::mesh::topology::{Csr, Topology};
 
 /// The paper's ε: the least cost of a step, so that on a plane the nearer seed wins.
@@ -151,7 +152,12 @@ struct Faces {
 }
 
 impl Faces {
+    /// The faces of `mesh`, their geometry taken in its unit frame
+    /// ([`crate::mesh::frames::unit_positions`]): in world coordinates a 1e-30 mesh's normals
+    /// underflowed to zero in f32 (every face degenerate), a 1e30 one's overflowed, and the
+    /// clusters of a mesh depended on its scale and place.
     fn new(mesh: &Mesh, topology: &Topology) -> Faces {
+        let positions = unit_positions(&mesh.positions);
         let n = mesh.triangle_count();
         let welded = |t: u32| mesh.triangles[t as usize].map(|v| topology.weld[v as usize]);
         let mut faces = Faces {
@@ -161,7 +167,7 @@ impl Faces {
             border: Vec::with_capacity(n),
         };
         for (t, tri) in mesh.triangles.iter().enumerate() {
-            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+            let [a, b, c] = tri.map(|v| positions[v as usize]);
             let cross = (b - a).cross(c - a);
             let centre = (a + b + c) / 3.0;
             faces.normal.push(cross.normalize_or_zero());
@@ -174,7 +180,7 @@ impl Faces {
                 let (wa, wb) = (w[k], w[(k + 1) % 3]);
                 let shared = || neighbours.iter().any(|&g| welded(g).contains(&wa) && welded(g).contains(&wb));
                 if wa != wb && !shared() {
-                    let midpoint = 0.5 * (mesh.positions[tri[k] as usize] + mesh.positions[tri[(k + 1) % 3] as usize]);
+                    let midpoint = 0.5 * (positions[tri[k] as usize] + positions[tri[(k + 1) % 3] as usize]);
                     border = border.min(f64::from(centre.distance(midpoint)));
                 }
             }
