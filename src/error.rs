@@ -50,3 +50,11 @@ impl Error {
         Error::Spec { path: path.display().to_string(), problem: problem.to_string() }
     }
 }
+
+/// `text` with control characters other than line breaks and tabs (a NUL, an escape sequence
+/// from a file's bytes) written as escapes, so no message carries them raw to a terminal.
+pub fn printable(text: &str) -> String {
+    text.chars()
+        .map(|c| if c.is_control() && c != '\n' && c != '\t' { c.escape_default().to_string() } else { c.to_string() })
+        .collect()
+}

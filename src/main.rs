@@ -38,6 +38,11 @@ struct Common {
     /// Seed for randomised methods (`random`), seeded meshes (`disk:N`) and `random:N` views.
     #[arg(long, default_value_t = 0, global = true)]
     seed: u64,
+    /// Let a glTF file's buffer URIs name files outside its own folder (absolute paths, file:
+    /// URIs, ../ out of the folder). Off by default: assets come from anywhere, and a URI could
+    /// otherwise read any file on disk.
+    #[arg(long, global = true)]
+    allow_outside_uris: bool,
 }
 
 /// What to measure, as in `eval` and `order`.
@@ -211,8 +216,13 @@ enum Command {
 
 fn main() -> ExitCode {
     quiet_mesa();
+    // After quiet_mesa, which must run before any thread exists: this starts one.
+    if let Err(e) = triorder::atomic::remove_temporaries_on_signals() {
+        eprintln!("warning: cannot handle interrupts ({e}): an interrupted output may leave a .triorder-*.tmp file");
+    }
     let cli = Cli::parse();
     let common = &cli.common;
+    triorder::mesh::gltf::allow_outside_uris(common.allow_outside_uris);
     let result = match cli.command {
         Command::Methods => commands::methods(),
         Command::Order { input, output, method, remap_vertices, measure, progressive } => {
@@ -229,7 +239,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", triorder::error::printable(&e.to_string()));
             ExitCode::from(2)
         }
     }

@@ -57,6 +57,7 @@ rejected! {
     ply_header_line_that_does_not_parse: "ply_bad_header_line.ply" => ["header line 5", "property flot y"];
     ply_list_longer_than_the_file: "ply_huge_list.ply" => ["face 0", "ends inside"];
     ply_empty: "empty.ply" => ["empty"];
+    ply_format_version_2: "ply_format_version_2.ply" => ["header line 2", "version 2.0 is not supported"];
     ply_that_is_text: "not_a_mesh.ply" => ["not a PLY file", "line 1"];
     obj_nan: "obj_nan.obj" => ["line 3", "'nan' is not a finite number"];
     obj_inf: "obj_inf.obj" => ["line 2", "'inf' is not a finite number"];
@@ -69,13 +70,14 @@ rejected! {
     obj_without_faces: "obj_no_faces.obj" => ["no faces", "4 vertices"];
     obj_empty: "empty.obj" => ["empty"];
     glb_empty: "empty.glb" => ["empty"];
-    glb_bad_magic: "glb_bad_magic.glb" => ["bad magic", "gLTf"];
+    glb_bad_magic: "glb_bad_magic.glb" => ["does not start with the GLB magic"];
+    glb_length_shorter_than_the_file: "glb_length_shorter_than_file.glb" => ["declared length 380 bytes", "the file has 424"];
     glb_buffer_view_past_the_buffer: "glb_view_past_end.glb" => ["buffer view 0", "past the end of buffer 0"];
     glb_accessor_past_its_view: "glb_accessor_past_view.glb" => ["accessor 0", "past the end of buffer view 0"];
     glb_accessor_index_out_of_range: "glb_accessor_index_out_of_range.glb" => ["mesh 0 primitive 0", "accessor 5"];
     glb_header_length_zero: "glb_header_length_zero.glb" => ["declared length 0"];
     glb_node_cycle: "glb_node_cycle.glb" => ["node", "cycle"];
-    glb_that_is_text: "not_a_mesh.glb" => ["bad magic"];
+    glb_that_is_text: "not_a_mesh.glb" => ["does not start with the GLB magic"];
     gltf_missing_bin: "gltf_missing_bin.gltf" => ["buffer 0", "missing.bin"];
     gltf_uri_that_is_not_utf8: "gltf_bad_uri.gltf" => ["buffer 0", "%FF.bin"];
     unsupported_extension: "mesh.stl" => ["unsupported file extension '.stl'"];

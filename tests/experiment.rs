@@ -147,10 +147,29 @@ modles = ["a"]"#,
 "#,
             &["quick.models[0]", "models/bunny_2k.ply"],
         ),
+        // Rows that would collide are found before the run, not by `plot` after it.
+        (r#"facet = "model""#, "", &["measures 2 models", "do not tell them apart", "model_triangles"]),
+        (r#"facet = "model""#, r#"facet = "model_triangles""#, &[]),
+        (
+            "facet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
+            r#"filter = { cache_kind = "fifo", model = "grid:4x4" }"#,
+            &[],
+        ),
+        (
+            "x = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
+            "x = \"model_triangles\"\nfacet = \"model\"",
+            &["measures 3 cache models", "cache_size"],
+        ),
+        (r#"filter = { cache_kind = "fifo" }"#, r#"series = "cache""#, &["measures 3 methods", "method_name"]),
     ];
     for (from, to, expected) in cases {
         assert!(TINY.contains(from), "{from}");
-        let err = spec_error("tiny", &TINY.replacen(from, to, if from.starts_with("models") { 2 } else { 1 }));
+        let text = TINY.replacen(from, to, if from.starts_with("models") { 2 } else { 1 });
+        if expected.is_empty() {
+            Spec::load(&common::write_spec(tempfile::tempdir().unwrap().path(), "tiny", &text)).unwrap();
+            continue;
+        }
+        let err = spec_error("tiny", &text);
         for want in *expected {
             assert!(err.contains(want), "`{to}`: error lacks `{want}`:\n{err}");
         }

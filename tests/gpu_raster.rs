@@ -144,6 +144,7 @@ res = 64
 kind = "bar"
 metric = "ovr_mean"
 x = "method"
+facet = "model"
 "#,
     );
     let read = |backend: &str| {

@@ -82,6 +82,7 @@ kind = "bar"
 metric = "acmr"
 x = "method"
 series = "cache"
+facet = "model"
 "#;
     let spec = common::write_spec(root.path(), "tiny-hw", text);
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };

@@ -90,7 +90,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
-use crate::figure::spec::{Figure, FigureKind, RawFigure, Writes, kind_name};
+use crate::figure::spec::{Figure, FigureKind, RawFigure, Varies, Writes, kind_name};
 use crate::figure::{Chart, PlotOptions};
 use crate::gpu::render_time::{MAX_FRAMES, Shading};
 use crate::measure::{self, CacheModel, GPU_CACHE, MeasureOptions};
@@ -164,7 +164,14 @@ impl Spec {
     /// Reads and checks the spec at `path`.
     pub fn load(path: &Path) -> Result<Spec> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::spec(path, format!("cannot read: {e}")))?;
-        let raw: RawSpec = toml::from_str(&text).map_err(|e| Error::spec(path, e.to_string().trim_end()))?;
+        Spec::parse(&text, path)
+    }
+
+    /// Checks the spec text `text`, read from `path` (which errors name and the id must match).
+    pub fn parse(text: &str, path: &Path) -> Result<Spec> {
+        // An editor's UTF-8 byte-order mark is not part of the first key.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let raw: RawSpec = toml::from_str(text).map_err(|e| Error::spec(path, e.to_string().trim_end()))?;
         raw.check(path)
     }
 
@@ -385,6 +392,7 @@ impl RawSpec {
             metrics: measure::ORDERING.iter().map(|n| n.name).chain(options.reported()).collect(),
             methods: &methods,
             animated: full.models.iter().any(|m| m.source.is_animation()),
+            varies: varies(&full, quick.as_ref(), &methods, &updates),
         };
         let figure = self.figure.check(&writes).map_err(err)?;
         let fits = |w: &Workload| w.gpu_vertices && !w.caches.is_empty();
@@ -590,6 +598,28 @@ fn integer_range(lo: &str, hi: &str) -> std::result::Result<Vec<i64>, String> {
         return Err(format!("has a range of {count} values (at most {MAX_EXPANSION})"));
     }
     Ok((0..count).map(|i| lo + i * step).collect())
+}
+
+/// What the rows of a run of `full` (or of `quick`) vary along, for the figure check: several
+/// models, methods, caches, levels or updates.
+fn varies(full: &Workload, quick: Option<&Workload>, methods: &[String], updates: &[Update]) -> Vec<Varies> {
+    let most = |count: fn(&Workload) -> usize| quick.map_or(0, count).max(count(full));
+    let every: fn(&str) -> bool = |_| true;
+    let per_cache: fn(&str) -> bool =
+        |m| crate::measure::Metric::names(&crate::measure::cache::METRIC).iter().any(|n| n.name == m);
+    let per_level: fn(&str) -> bool = |m| !crate::measure::ORDERING.iter().any(|n| n.name == m);
+    let model_columns = &["model", "model_base", "model_triangles", "model_vertices", "source:"][..];
+    [
+        (most(|w| w.models.len()), "models", model_columns, every),
+        (methods.len(), "methods", &["method", "method_name", "seed", "peer", "param:"][..], every),
+        (most(|w| w.caches.len()), "cache models", &["cache", "cache_kind", "cache_size"][..], per_cache),
+        (most(|w| w.levels.len()), "levels", &["level", "model_triangles", "model_vertices"][..], per_level),
+        (updates.len(), "updates", &["update"][..], every),
+    ]
+    .into_iter()
+    .filter(|(count, ..)| *count > 1)
+    .map(|(count, what, columns, splits)| Varies { what: format!("{count} {what}"), columns, splits })
+    .collect()
 }
 
 #[cfg(test)]

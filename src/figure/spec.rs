@@ -17,6 +17,26 @@ pub struct Writes<'a> {
     pub methods: &'a [String],
     /// Whether some model is an animation (so `source:KEY` columns exist).
     pub animated: bool,
+    /// What the rows vary along beside the metric (models, methods, caches, levels, updates),
+    /// each with the columns that tell its values apart (a name ending in `:` stands for every
+    /// column it begins). A line, bar or table figure must use one of them for each, or rows
+    /// would collide at one point.
+    pub varies: Vec<Varies>,
+}
+
+/// One thing a run's rows vary along: see [`Writes::varies`].
+pub struct Varies {
+    /// What varies, as a user reads it: "3 models".
+    pub what: String,
+    pub columns: &'static [&'static str],
+    /// Whether it splits the rows of a metric (the ordering's time is one for all levels).
+    pub splits: fn(&str) -> bool,
+}
+
+impl Varies {
+    fn told_apart_by(&self, column: &str) -> bool {
+        self.columns.iter().any(|c| *c == column || (c.ends_with(':') && column.starts_with(c)))
+    }
 }
 
 /// How the figure is drawn from the CSV.
@@ -237,6 +257,20 @@ impl RawFigure {
         joined("figure.series", &series)?;
         if let Some(facet) = &self.facet {
             joined("figure.facet", facet)?;
+        }
+        if matches!(self.kind, FigureKind::Line | FigureKind::Bar | FigureKind::Table) {
+            let mut used: Vec<&str> = series.split('+').chain(self.x.as_deref()).collect();
+            used.extend(self.facet.as_deref().map(|f| f.split('+')).into_iter().flatten());
+            used.extend(self.filter.keys().map(String::as_str));
+            let splits = |v: &Varies| metrics.iter().any(|m| (v.splits)(m));
+            if let Some(v) = writes.varies.iter().find(|v| splits(v) && !used.iter().any(|c| v.told_apart_by(c))) {
+                return Err(format!(
+                    "the run measures {}, but figure.x, series and facet do not tell them apart (nor does \
+                     figure.filter pick one), so their rows would fall on the same points: use one of {} there",
+                    v.what,
+                    v.columns.join(", ")
+                ));
+            }
         }
         let mut filter = Vec::new();
         for (key, value) in self.filter {

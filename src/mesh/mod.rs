@@ -25,6 +25,10 @@ pub mod topology;
 
 use glam::Vec3;
 
+/// The UTF-8 byte-order mark some editors put at the start of a text file. Readers of text
+/// formats (OBJ, PLY headers, glTF JSON, specs) skip it: it is not part of the first line.
+pub const BOM: &[u8] = b"\xEF\xBB\xBF";
+
 pub use frames::{Frames, Framing};
 pub use scene::Scene;
 pub use source::Source;

@@ -31,7 +31,8 @@ use crate::mesh::{Mesh, VertexAttributes};
 /// colours are kept when every vertex has them, otherwise dropped and reported.
 pub fn read(bytes: &[u8], origin: &str) -> Result<(Mesh, LoadReport)> {
     // Numbers and keywords are ASCII; a stray Latin-1 byte in a comment must not fail the file.
-    let text = String::from_utf8_lossy(bytes);
+    // A UTF-8 byte-order mark would otherwise be read as part of the first keyword.
+    let text = String::from_utf8_lossy(bytes.strip_prefix(crate::mesh::BOM).unwrap_or(bytes));
     if text.trim().is_empty() {
         return Err(Error::input(origin, "not an OBJ file: the file is empty"));
     }
@@ -103,7 +104,47 @@ struct Counts {
     colored: usize,
     faces: usize,
     polylines: usize,
+    /// Lines whose keyword OBJ does not define, and where the first one is.
+    unknown: usize,
+    first_unknown: String,
 }
+
+/// The keywords of the OBJ specification (and `mtllib`'s companions) that carry no triangles:
+/// skipped without a word. Any other keyword is counted and reported.
+const OTHER_KEYWORDS: [&str; 32] = [
+    "o",
+    "g",
+    "s",
+    "mg",
+    "usemtl",
+    "mtllib",
+    "usemap",
+    "maplib",
+    "vp",
+    "p",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
+    "stech",
+];
 
 /// The outcome of [`check`]: the lines `tobj` should see, and what they leave out.
 struct Checked {
@@ -166,8 +207,15 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
                 seen.polylines += 1;
                 continue;
             }
-            // Grouping, materials, smoothing groups, comments and anything unknown: not geometry.
-            _ => continue,
+            // Grouping, materials, smoothing groups, free-form geometry: not triangles.
+            k if OTHER_KEYWORDS.contains(&k) => continue,
+            unknown => {
+                if seen.unknown == 0 {
+                    seen.first_unknown = format!("`{}` on line {}", crate::error::printable(unknown), index + 1);
+                }
+                seen.unknown += 1;
+                continue;
+            }
         }
         kept.push_str(keyword);
         for value in &values {
@@ -181,6 +229,12 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
         return Err(format!("no faces: the file has {} vertices and no `f` lines", seen.positions));
     }
     let mut dropped = Vec::new();
+    if seen.unknown > 0 {
+        dropped.push(format!(
+            "{} line(s) with a keyword OBJ does not define, skipped (the first: {})",
+            seen.unknown, seen.first_unknown
+        ));
+    }
     if seen.polylines > 0 {
         dropped.push(format!("{} polyline (`l`) elements: only faces are loaded", seen.polylines));
     }

@@ -47,6 +47,8 @@ pub fn read(bytes: &[u8], origin: &str) -> Result<(Mesh, LoadReport)> {
     if bytes.is_empty() {
         return Err(fail("not a PLY file: the file is empty".into()));
     }
+    // The header is text, which an editor may have saved with a UTF-8 byte-order mark.
+    let bytes = bytes.strip_prefix(crate::mesh::BOM).unwrap_or(bytes);
     let first_line = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
     if first_line.trim_ascii_end() != b"ply" {
         return Err(fail("not a PLY file: line 1 is not 'ply'".into()));
@@ -62,12 +64,23 @@ pub fn read(bytes: &[u8], origin: &str) -> Result<(Mesh, LoadReport)> {
             let message = e.line().and_then(|n| message.strip_prefix(&format!("Line {n}: "))).unwrap_or(&message);
             let first = message.lines().next().unwrap_or_default();
             match e.line().and_then(|n| header_text.line(n).map(|text| (n, text))) {
+                Some((n, text)) if first.starts_with("Couldn't parse line") => {
+                    fail(format!("header line {n} ('{text}'): {}", explain_header_line(text)))
+                }
                 Some((n, text)) => fail(format!("header line {n} ('{text}'): {first}")),
                 None => fail(format!("header: {first}")),
             }
         })?
     };
     header_text.check_duplicates().map_err(fail)?;
+    let version = &header.version;
+    if (version.major, version.minor) != (1, 0) {
+        let line = header_text.words().find(|(_, w)| w.first() == Some(&"format")).map_or(2, |(n, _)| n);
+        return Err(fail(format!(
+            "header line {line}: PLY format version {}.{} is not supported (the only PLY version is 1.0)",
+            version.major, version.minor
+        )));
+    }
 
     let vertex_def = header.elements.get("vertex").ok_or_else(|| fail("header: no 'vertex' element".into()))?;
     let layout = VertexLayout::of(vertex_def, &header_text).map_err(fail)?;
@@ -146,7 +159,9 @@ impl Payload<'_> {
         let row = self.parser.read_ascii_element(line, def).map_err(|e| {
             match line.split_ascii_whitespace().find(|t| !plain_number(t)) {
                 Some(token) => format!("{at}: '{token}' is not a number"),
-                None => format!("{at}: {}", one_line(&e.to_string())),
+                None => {
+                    format!("{at}: {}", explain_ascii_values(line, def).unwrap_or_else(|| one_line(&e.to_string())))
+                }
             }
         })?;
         let expected: usize = row.0.iter().map(|p| list_len(p).map_or(1, |n| 1 + n)).sum();
@@ -181,6 +196,78 @@ fn plain_number(token: &str) -> bool {
         None => digits(mantissa),
     };
     mantissa_ok && exponent.is_none_or(|e| digits(&e))
+}
+
+/// What a header line that does not parse should look like, in place of `ply-rs-bw`'s
+/// "Couldn't parse line." and its grammar's debug text.
+fn explain_header_line(text: &str) -> String {
+    const TYPES: [&str; 16] = [
+        "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8", "int16", "uint16",
+        "int32", "uint32", "float32", "float64",
+    ];
+    let words: Vec<&str> = text.split_whitespace().collect();
+    // The type words: `property TYPE NAME`, or `property list COUNT_TYPE TYPE NAME`.
+    let types = if words.get(1) == Some(&"list") { words.get(2..4) } else { words.get(1..2) };
+    let unknown = types.unwrap_or_default().iter().find(|t| !TYPES.contains(t));
+    match words.first().copied() {
+        Some("format") => "a format line is 'format ascii|binary_little_endian|binary_big_endian 1.0'".into(),
+        Some("element") => "an element line is 'element NAME COUNT', with COUNT a whole number".into(),
+        Some("property") if unknown.is_some() => {
+            format!("unknown property type '{}' (known: {})", unknown.unwrap_or(&""), TYPES.join(", "))
+        }
+        Some("property") => "a property line is 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME'".into(),
+        _ => "not a PLY header line (one of format, element, property, comment, obj_info, end_header)".into(),
+    }
+}
+
+/// Why the ASCII `line` (whose tokens are all numbers) does not hold `def`'s values, in the
+/// header's words, where `ply-rs-bw` would say `ParseIntError { kind: PosOverflow }` or speak of
+/// "list elements": a value that does not fit its property's type, or a list longer than the
+/// line.
+fn explain_ascii_values(line: &str, def: &ElementDef) -> Option<String> {
+    let mut tokens = line.split_ascii_whitespace();
+    for (name, property) in def.properties.iter() {
+        let (count_type, item_type) = match &property.data_type {
+            PropertyType::Scalar(scalar) => (None, scalar),
+            PropertyType::List(count, item) => (Some(count), item),
+        };
+        let count = match count_type {
+            None => 1,
+            Some(count_type) => {
+                let token = tokens.next()?;
+                if let Err(range) = fits(token, count_type) {
+                    return Some(format!("list length '{token}' of '{name}' does not fit its type ({range})"));
+                }
+                token.parse::<usize>().ok()?
+            }
+        };
+        for k in 0..count {
+            let Some(token) = tokens.next() else {
+                return Some(format!("the list '{name}' declares {count} values, but the line ends after {k}"));
+            };
+            if let Err(range) = fits(token, item_type) {
+                return Some(format!("'{token}' does not fit the property '{name}' ({range})"));
+            }
+        }
+    }
+    None
+}
+
+/// Ok if the number `token` is a value of `scalar`; else the type's range, as words.
+fn fits(token: &str, scalar: &ScalarType) -> std::result::Result<(), String> {
+    let (min, max, name): (i128, i128, &str) = match scalar {
+        ScalarType::Char => (i8::MIN.into(), i8::MAX.into(), "char"),
+        ScalarType::UChar => (0, u8::MAX.into(), "uchar"),
+        ScalarType::Short => (i16::MIN.into(), i16::MAX.into(), "short"),
+        ScalarType::UShort => (0, u16::MAX.into(), "ushort"),
+        ScalarType::Int => (i32::MIN.into(), i32::MAX.into(), "int"),
+        ScalarType::UInt => (0, u32::MAX.into(), "uint"),
+        ScalarType::Float | ScalarType::Double => return Ok(()),
+    };
+    match token.parse::<i128>() {
+        Ok(v) if (min..=max).contains(&v) => Ok(()),
+        _ => Err(format!("{name}: a whole number from {min} to {max}")),
+    }
 }
 
 /// `ply-rs-bw` messages span several tab-indented lines; an error message is one line.

@@ -130,10 +130,12 @@ impl Source {
 }
 
 /// Splits `PATH@N` into the base source and the triangle count; `None` when `source` has no such
-/// suffix (an `@` followed by something other than digits is part of a file name).
+/// suffix (in a file name, an `@` followed by something other than digits is part of the name;
+/// after a procedural spec it can only be a count, checked by [`parse_target`]).
 fn parse_simplified(source: &str) -> Option<(&str, &str)> {
     let (base, count) = source.rsplit_once('@')?;
-    (!count.is_empty() && count.bytes().all(|b| b.is_ascii_digit())).then_some((base, count))
+    let digits = !count.is_empty() && count.bytes().all(|b| b.is_ascii_digit());
+    (digits || procedural::check(base).is_some()).then_some((base, count))
 }
 
 /// Checks the `N` of `PATH@N`: a positive triangle count.

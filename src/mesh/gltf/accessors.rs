@@ -74,9 +74,21 @@ fn components(layout: &Layout<'_>, i: usize, t: DataType, into: &mut Vec<f64>) {
     }
 }
 
-/// The most elements a sparse accessor without a buffer view may have: it is all zeros but the
-/// substitutions, so its count is the only thing sizing the allocation.
-const MAX_VIEWLESS_ELEMENTS: usize = 1 << 26;
+/// Whether a sparse accessor without a buffer view, `count` elements of `element` bytes, is as
+/// large as the file's data can account for. Such an accessor is all zeros but the
+/// substitutions, so its count alone sizes the allocation: a few bytes of JSON could declare
+/// gigabytes. Where it is used (morph-target deltas, a sparse position array) its elements
+/// stand beside another accessor's that are stored, so its stored size may not exceed all the
+/// buffers' bytes together.
+fn viewless_size_ok(count: usize, element: usize, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+    let backed: usize = buffers.iter().map(Vec::len).sum();
+    match count.checked_mul(element) {
+        Some(size) if size <= backed => Ok(()),
+        _ => Err(format!(
+            "count {count} without a buffer view ({element}-byte elements) exceeds the {backed} bytes of the file's buffers"
+        )),
+    }
+}
 
 /// All of an accessor's components, as stored (not normalised), sparse substitutions applied.
 pub(super) fn accessor_values(
@@ -98,10 +110,10 @@ pub(super) fn accessor_values(
             }
         }
         // Only a sparse accessor has no view; its count is not bounded by any buffer's size.
-        None if count > MAX_VIEWLESS_ELEMENTS => {
-            return Err(format!("{what}: count {count} without a buffer view exceeds {MAX_VIEWLESS_ELEMENTS}"));
+        None => {
+            viewless_size_ok(count, element, buffers).map_err(|problem| format!("{what}: {problem}"))?;
+            values.resize(count * dims, 0.0);
         }
-        None => values.resize(count * dims, 0.0),
     }
     if let Some(sparse) = accessor.sparse() {
         let n = sparse.count();

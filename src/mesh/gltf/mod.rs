@@ -30,6 +30,7 @@ use glam::Mat4;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::load::LoadReport;
+pub use document::allow_outside_uris;
 use document::open;
 use primitive::merge;
 use scene::{ScenePart, joint_matrices, scene_parts, world_transforms};

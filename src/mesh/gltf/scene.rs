@@ -31,6 +31,9 @@ pub(super) fn scene_parts<'a>(
 ) -> std::result::Result<Vec<ScenePart<'a>>, String> {
     let mut parts = Vec::new();
     let mut unloaded = BTreeSet::new();
+    // Instancing reuses one accessor under many nodes, so a few kilobytes can describe any
+    // number of triangles: the merged mesh is held to what a spec may ask for.
+    let mut total = 0u64;
     for node in scene_nodes(document)? {
         let Some(mesh) = node.mesh() else { continue };
         for primitive in mesh.primitives() {
@@ -43,6 +46,14 @@ pub(super) fn scene_parts<'a>(
                 }
             }
             let part = Part::read(&primitive, buffers, &at, node.skin().is_some(), &mut unloaded)?;
+            total += part.triangles.len() as u64;
+            if total > crate::mesh::procedural::MAX_TRIANGLES {
+                return Err(format!(
+                    "{at} (node {}): the scene's instances add up to more than {} triangles, the most triorder loads",
+                    node.index(),
+                    crate::mesh::procedural::MAX_TRIANGLES
+                ));
+            }
             parts.push(ScenePart { node: node.clone(), primitive, at, part });
         }
     }

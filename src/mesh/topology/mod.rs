@@ -17,6 +17,11 @@ use std::collections::HashMap;
 
 use crate::mesh::Mesh;
 
+/// The most triangles on one edge that are all linked to each other in [`Topology::neighbors`]:
+/// scanned and decimated meshes have a few on their non-manifold edges, but 20,000 copies of one
+/// face in a 160 KB file would otherwise ask for 400 million links (15 GB).
+pub const MAX_EDGE_CLIQUE: usize = 16;
+
 /// Compressed sparse rows: `items[offsets[i]..offsets[i + 1]]` belong to row `i`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Csr {
@@ -69,7 +74,10 @@ pub struct Topology {
     /// Mesh vertex → canonical welded vertex (the first vertex with the same position).
     pub weld: Vec<u32>,
     /// The dual graph: triangle → triangles sharing an undirected welded edge (no self loops,
-    /// no repeats). Non-manifold edges link every pair of their triangles.
+    /// no repeats). A non-manifold edge links every pair of its triangles, up to
+    /// [`MAX_EDGE_CLIQUE`] of them; an edge shared by more (a fan of duplicate faces, hostile or
+    /// not) links them in a chain instead, so the graph stays linear in the triangles and its
+    /// components are the same.
     pub neighbors: Csr,
     /// Triangle → connected component of the dual graph, numbered from 0 in order of first triangle.
     pub component: Vec<u32>,
@@ -112,13 +120,18 @@ impl Topology {
                 2 => inconsistent_edges += usize::from(group[0].2 == group[1].2),
                 _ => non_manifold_edges += 1,
             }
-            for (i, x) in group.iter().enumerate() {
-                for y in &group[i + 1..] {
-                    if x.1 != y.1 {
-                        links.push((x.1, y.1));
-                        links.push((y.1, x.1));
-                    }
+            let mut link = |x: u32, y: u32| {
+                if x != y {
+                    links.extend([(x, y), (y, x)]);
                 }
+            };
+            // Every pair on an edge, or along a chain past MAX_EDGE_CLIQUE (see `neighbors`).
+            if group.len() <= MAX_EDGE_CLIQUE {
+                for (i, x) in group.iter().enumerate() {
+                    group[i + 1..].iter().for_each(|y| link(x.1, y.1));
+                }
+            } else {
+                group.windows(2).for_each(|w| link(w[0].1, w[1].1));
             }
         }
         links.sort_unstable();

@@ -122,7 +122,13 @@ write("gltf_missing_bin.gltf", json.dumps(triangle_gltf(buffer={"byteLength": 36
 # "%FF" decodes to a byte that is not UTF-8: the gltf crate's URI decoding panics on it.
 write("gltf_bad_uri.gltf", json.dumps(triangle_gltf(buffer={"byteLength": 36, "uri": "%FF.bin"}), indent=1))
 write("empty.glb", b"")
+# The header's total length covers the JSON chunk only; the BIN chunk follows it anyway.
+short = glb(triangle_gltf(), TRIANGLE_BIN)
+write("glb_length_shorter_than_file.glb", short[:8] + struct.pack("<I", len(short) - 44) + short[12:])
 write("not_a_mesh.glb", "This is a shopping list, not a mesh.\n- eggs\n- flour\n")
+
+write("ply_format_version_2.ply", ply_header("ascii").replace(b"ascii 1.0", b"ascii 2.0")
+      + b"0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n")
 
 # --- other ---
 write("mesh.stl", "solid triangle\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
