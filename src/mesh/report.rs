@@ -95,6 +95,14 @@ impl MeshReport {
 /// mesh underflowed to zero (and every triangle was reported degenerate); a threshold relative to
 /// the mesh's size would instead call thin but proper triangles degenerate.
 pub fn has_zero_area([a, b, c]: [Vec3; 3]) -> bool {
+    // The filter: in f64 the cross product of a triangle with an area worth the name is far from
+    // zero (its rounding error is a few units in the last place of the edges' product), so only
+    // nearly degenerate triangles take the exact path.
+    let (d1, d2) = (b.as_dvec3() - a.as_dvec3(), c.as_dvec3() - a.as_dvec3());
+    let bound = 8.0 * f64::EPSILON * d1.abs().element_sum() * d2.abs().element_sum();
+    if d1.cross(d2).abs().max_element() > bound {
+        return false;
+    }
     // The determinant of rows (a_u, a_v, 1), (b_u, b_v, 1), (c_u, c_v, 1) over the axes u, v: the
     // component of the cross product along the third axis.
     let orient = |u: usize, v: usize| {
@@ -108,17 +116,17 @@ pub fn has_zero_area([a, b, c]: [Vec3; 3]) -> bool {
 /// nonoverlapping expansion by error-free two-sums (Shewchuk 1997, "Adaptive precision
 /// floating-point arithmetic and fast robust geometric predicates", Grow-Expansion), whose
 /// components then sum exactly to the terms' sum, and which is zero only when every component is.
-fn exact_sum_is_zero(terms: &[f64]) -> bool {
-    let mut expansion: Vec<f64> = Vec::with_capacity(terms.len());
-    for &term in terms {
+fn exact_sum_is_zero<const N: usize>(terms: &[f64; N]) -> bool {
+    let mut expansion = [0.0f64; N];
+    for (n, &term) in terms.iter().enumerate() {
         let mut q = term;
-        for e in &mut expansion {
+        for e in &mut expansion[..n] {
             let s = q + *e;
             let b = s - q;
             let error = (q - (s - b)) + (*e - b);
             (q, *e) = (s, error);
         }
-        expansion.push(q);
+        expansion[n] = q;
     }
     expansion.iter().all(|&e| e == 0.0)
 }
