@@ -5,6 +5,8 @@
 //! what is wrong with each). Several of them make the parsing libraries themselves panic or
 //! silently accept bad data when used directly; see the module docs of `src/mesh/{obj,ply,gltf}.rs`.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
@@ -18,16 +20,7 @@ fn bad(name: &str) -> PathBuf {
 
 /// Loading `name` fails with a message naming the file and containing every phrase.
 fn assert_rejected(name: &str, phrases: &[&str]) {
-    let path = bad(name);
-    assert!(path.exists(), "{} is missing from the corpus", path.display());
-    let message = match load_file(&path) {
-        Ok(mesh) => panic!("{name} loaded ({} triangles) but is broken", mesh.triangle_count()),
-        Err(e) => e.to_string(),
-    };
-    assert!(message.contains(&path.display().to_string()), "{name}: the error does not name the file: {message}");
-    for phrase in phrases {
-        assert!(message.contains(phrase), "{name}: expected {phrase:?} in: {message}");
-    }
+    common::rejected(&bad(name), phrases);
 }
 
 macro_rules! rejected {

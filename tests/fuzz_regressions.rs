@@ -2,6 +2,8 @@
 //! beyond their size: each must now give an error that names the file. The files live in
 //! `tests/data/fuzz/`, whose README.md says what each did.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use triorder::mesh::load::load_file;
@@ -12,16 +14,7 @@ fn found(name: &str) -> PathBuf {
 
 /// Loading `name` fails with a message naming the file and containing every phrase.
 fn assert_rejected(name: &str, phrases: &[&str]) {
-    let path = found(name);
-    assert!(path.exists(), "{} is missing", path.display());
-    let message = match load_file(&path) {
-        Ok(mesh) => panic!("{name} loaded ({} triangles) but is broken", mesh.triangle_count()),
-        Err(e) => e.to_string(),
-    };
-    assert!(message.contains(&path.display().to_string()), "{name}: the error does not name the file: {message}");
-    for phrase in phrases {
-        assert!(message.contains(phrase), "{name}: expected {phrase:?} in: {message}");
-    }
+    common::rejected(&found(name), phrases);
 }
 
 #[test]

@@ -3,6 +3,8 @@
 //! error quotes the bytes it read; a UTF-8 byte-order mark never changes what a text file
 //! means; unknown OBJ keywords are reported, not skipped in silence.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -56,19 +58,6 @@ impl Root {
     }
 }
 
-/// Loading `path` fails naming the file and containing every phrase.
-fn refused(path: &Path, phrases: &[&str]) -> String {
-    let message = match load_file(path) {
-        Ok(mesh) => panic!("{} loaded ({} triangles)", path.display(), mesh.triangle_count()),
-        Err(e) => e.to_string(),
-    };
-    assert!(message.contains(&path.display().to_string()), "the error does not name the file: {message}");
-    for phrase in phrases {
-        assert!(message.contains(phrase), "expected {phrase:?} in: {message}");
-    }
-    message
-}
-
 /// `triorder eval PATH --allow-outside-uris`: its status and stderr.
 fn eval_allowing(path: &Path) -> (bool, String) {
     let o = Command::new(env!("CARGO_BIN_EXE_triorder"))
@@ -100,7 +89,7 @@ fn uris_that_leave_the_folder_are_refused_and_say_how_to_allow_them() {
     ];
     for (name, uri, why) in cases {
         let path = root.model(name, &uri);
-        refused(&path, &["buffer 0", why, allow]);
+        common::rejected(&path, &["buffer 0", why, allow]);
         let (ok, stderr) = eval_allowing(&path);
         assert!(ok, "{name} with {allow}: {stderr}");
     }
@@ -108,7 +97,7 @@ fn uris_that_leave_the_folder_are_refused_and_say_how_to_allow_them() {
     {
         std::os::unix::fs::symlink(&outside, root.path("model/link.bin")).unwrap();
         let path = root.model("link", "link.bin");
-        refused(&path, &["buffer 0", "leads outside the model's folder", allow]);
+        common::rejected(&path, &["buffer 0", "leads outside the model's folder", allow]);
         assert!(eval_allowing(&path).0);
     }
 }
@@ -116,9 +105,9 @@ fn uris_that_leave_the_folder_are_refused_and_say_how_to_allow_them() {
 #[test]
 fn other_schemes_and_nul_bytes_are_refused() {
     let root = Root::new();
-    refused(&root.model("http", "http://example.com/tri.bin"), &["scheme 'http:'"]);
-    refused(&root.model("host", "file://server/tri.bin"), &["file: URI"]);
-    refused(&root.model("nul", "sub/tri%00.bin"), &["NUL byte"]);
+    common::rejected(&root.model("http", "http://example.com/tri.bin"), &["scheme 'http:'"]);
+    common::rejected(&root.model("host", "file://server/tri.bin"), &["file: URI"]);
+    common::rejected(&root.model("nul", "sub/tri%00.bin"), &["NUL byte"]);
 }
 
 /// A device never ends and a pipe blocks whoever opens it: only regular files are read, even
@@ -128,14 +117,14 @@ fn other_schemes_and_nul_bytes_are_refused() {
 fn devices_and_pipes_are_not_read() {
     let root = Root::new();
     let zero = root.model("zero", "/dev/zero");
-    refused(&zero, &["absolute path"]);
+    common::rejected(&zero, &["absolute path"]);
     let (ok, stderr) = eval_allowing(&zero);
     assert!(!ok && stderr.contains("not a regular file"), "{stderr}");
     let fifo = root.path("model/pipe");
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
-    refused(&root.model("fifo", "pipe"), &["not a regular file"]);
+    common::rejected(&root.model("fifo", "pipe"), &["not a regular file"]);
     std::fs::create_dir(root.path("model/folder")).unwrap();
-    refused(&root.model("folder", "folder"), &["not a regular file"]);
+    common::rejected(&root.model("folder", "folder"), &["not a regular file"]);
 }
 
 /// A buffer file shorter than its `byteLength` is an error that does not quote it; a longer one
@@ -144,7 +133,7 @@ fn devices_and_pipes_are_not_read() {
 fn buffers_are_read_to_their_declared_length_and_never_quoted() {
     let root = Root::new();
     std::fs::write(root.path("model/short.bin"), b"SECRET-PASSWORD").unwrap();
-    let message = refused(&root.model("short", "short.bin"), &["holds 15 bytes", "declares 48"]);
+    let message = common::rejected(&root.model("short", "short.bin"), &["holds 15 bytes", "declares 48"]);
     assert!(!message.contains("SECRET"), "the error quotes the file: {message}");
     let mut long = triangle_bin();
     long.extend(std::iter::repeat_n(7u8, 1 << 20));
@@ -153,7 +142,7 @@ fn buffers_are_read_to_their_declared_length_and_never_quoted() {
     // A file that is not a GLB is not quoted either.
     let text = root.path("model/list.glb");
     std::fs::write(&text, "SECRET shopping list: eggs").unwrap();
-    let message = refused(&text, &["GLB magic"]);
+    let message = common::rejected(&text, &["GLB magic"]);
     assert!(!message.contains("SECRET") && !message.contains("shop"), "{message}");
 }
 
@@ -235,7 +224,7 @@ fn messages_name_the_problem_in_our_words() {
     assert!(message.contains("`@abc`") && !message.contains("width"), "{message}");
     let glb = root.path("model/twelve.glb");
     std::fs::write(&glb, [&b"glTF"[..], &2u32.to_le_bytes(), &12u32.to_le_bytes()].concat()).unwrap();
-    let message = refused(&glb, &["declared length 12 bytes, less than a header and one chunk"]);
+    let message = common::rejected(&glb, &["declared length 12 bytes, less than a header and one chunk"]);
     assert!(!message.contains("the file has 12"), "{message}");
 }
 

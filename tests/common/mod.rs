@@ -101,3 +101,18 @@ pub fn static_order(resolved: &triorder::order::Resolved, mesh: &Mesh) -> triord
     let orders = triorder::order::run(resolved, &scene)?;
     Ok(orders.single().expect("a static method gives one order").order.clone())
 }
+
+/// Loading `path` fails, without a panic, with a message that names the file and contains every
+/// phrase; returns the message.
+pub fn rejected(path: &std::path::Path, phrases: &[&str]) -> String {
+    assert!(path.exists(), "{} is missing", path.display());
+    let message = match load::load_file(path) {
+        Ok(mesh) => panic!("{} loaded ({} triangles) but is broken", path.display(), mesh.triangle_count()),
+        Err(e) => e.to_string(),
+    };
+    assert!(message.contains(&path.display().to_string()), "the error does not name the file: {message}");
+    for phrase in phrases {
+        assert!(message.contains(phrase), "{}: expected {phrase:?} in: {message}", path.display());
+    }
+    message
+}
