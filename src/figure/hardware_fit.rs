@@ -166,7 +166,7 @@ fn ranking(area: &Area, fits: &[Fit]) -> DrawResult {
         area.draw_text(&format!("… and {} more, worse", fits.len() - TABLE_ROWS), &body, (20, y))?;
     }
     y += 34;
-    area.draw_text(&format!("best ordering under {} / counted on the GPU", fits[0].cache), &head, (20, y))?;
+    area.draw_text(&format!("best ordering under {} / as counted by the device", fits[0].cache), &head, (20, y))?;
     for (mesh, model_best, counted_best) in &fits[0].best {
         y += 20;
         let short = mesh.rsplit('/').next().unwrap_or(mesh);

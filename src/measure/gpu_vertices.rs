@@ -54,6 +54,6 @@ impl Metric for Counted {
     }
 
     fn columns(&self, values: &[&Value]) -> Vec<(String, String)> {
-        acmr_atvr_columns(values, |_| "ACMR/ATVR counted on the GPU".into())
+        acmr_atvr_columns(values, |_| "ACMR/ATVR counted by the Vulkan device".into())
     }
 }
