@@ -69,13 +69,14 @@ enum Content {
 }
 
 /// Per drawn triangle: its cluster's colour and index. Distinct colours are golden-ratio hues;
-/// in `by_rank` the first cluster drawn is black and the last white.
+/// in `by_rank` the first cluster drawn is black and the last a light grey (the paper's white
+/// would vanish into the page).
 fn cluster_colours(starts: &[usize], by_rank: bool) -> Vec<([u8; 3], u32)> {
     let n = starts.len() - 1;
     let mut colours = Vec::with_capacity(*starts.last().unwrap_or(&0));
     for (c, w) in starts.windows(2).enumerate() {
         let colour = if by_rank {
-            let g = (255.0 * c as f64 / (n.max(2) - 1) as f64).round() as u8;
+            let g = (f64::from(LAST_GREY) * c as f64 / (n.max(2) - 1) as f64).round() as u8;
             [g, g, g]
         } else {
             let (r, g, b) = HSLColor((c as f64 * 0.618_034).fract(), 0.65, 0.55).rgb();
@@ -85,6 +86,10 @@ fn cluster_colours(starts: &[usize], by_rank: bool) -> Vec<([u8; 3], u32)> {
     }
     colours
 }
+
+/// The grey of the last cluster drawn in a cluster-order drawing: as light as a reader can still
+/// tell from the white page.
+const LAST_GREY: u8 = 215;
 
 /// Grey levels of the overdraw heat map: 1, 2, 3, 4 and 5 or more fragments shaded at a pixel.
 const OVERDRAW_GREYS: [u8; 5] = [235, 175, 120, 70, 20];
@@ -544,7 +549,7 @@ fn legend(root: &super::axes::Area, kind: &Content, y: i32) -> DrawResult {
         Content::Clusters(colours) if colours.first().is_some_and(|c| c.0 == [0, 0, 0]) => swatches(
             root,
             y,
-            &[([0, 0, 0], "first cluster drawn"), ([128, 128, 128], "…"), ([255, 255, 255], "last cluster drawn")],
+            &[([0, 0, 0], "first cluster drawn"), ([108, 108, 108], "…"), ([LAST_GREY; 3], "last cluster drawn")],
         ),
         Content::Clusters(_) => root.draw_text("colour: cluster (facets shaded by angle to the view)", &style, (12, y)),
         Content::Overdraw(_) => {
