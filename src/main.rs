@@ -179,6 +179,23 @@ enum Command {
         /// Raster backend for overdraw, overriding the spec's: cpu or gpu (Vulkan through wgpu).
         #[arg(long, value_name = "cpu|gpu")]
         backend: Option<String>,
+        /// Run shard K of N (K = 1..N) of the spec's (model, method) units, balanced by estimated
+        /// cost, into results/ID.shard-K-of-N.csv; `triorder merge SPEC` joins the shards into
+        /// results/ID.csv. A shard already complete for this spec and version is skipped. For
+        /// job arrays: scripts/slurm/submit.sh.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+    },
+    /// Join the shard files of a sharded run (run SPEC --shard K/N) into results/ID.csv, after
+    /// checking that every shard is present and from this spec and version.
+    Merge {
+        spec: PathBuf,
+        /// Merge the quick run's shards (results/quick/).
+        #[arg(long)]
+        quick: bool,
+        /// The number of shards, when results/ holds shards of several cuts of the spec.
+        #[arg(long, value_name = "N")]
+        shards: Option<usize>,
     },
     /// Draw paper-figures/ID.svg from results/ID.csv (no recomputation).
     Plot {
@@ -231,7 +248,8 @@ fn main() -> ExitCode {
         Command::Eval { mesh, methods, measure, animation, progressive, json } => {
             commands::eval(&mesh, &methods, &measure, &animation, &progressive, json, common)
         }
-        Command::Run { spec, quick, backend } => commands::run(&spec, quick, backend, common),
+        Command::Run { spec, quick, backend, shard } => commands::run(&spec, quick, backend, shard.as_deref(), common),
+        Command::Merge { spec, quick, shards } => commands::merge(&spec, quick, shards, common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick, common),
         Command::Reproduce { quick, only, backend } => commands::reproduce(quick, only.as_deref(), backend, common),
         Command::Bench { reps, meshes, only } => commands::bench(reps, &meshes, only, common),

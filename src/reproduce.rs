@@ -30,6 +30,9 @@ pub struct Outcome {
     pub ran: Vec<(String, PathBuf, PathBuf)>,
     /// Each spec skipped, and why.
     pub skipped: Vec<(String, String)>,
+    /// Each model (and method) that failed in a spec, which went on without it: the spec's id and
+    /// the failure.
+    pub failures: Vec<(String, crate::experiment::Failure)>,
     /// The GPU the specs that needed one ran on, if any did.
     pub device: Option<String>,
     /// Wall time of the whole reproduction.
@@ -76,9 +79,10 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
             overall.inc(1);
             continue;
         }
-        let csv = run_spec(spec, opts, &bars)?;
+        let run = run_spec(spec, opts, &bars)?;
+        outcome.failures.extend(run.failures.into_iter().map(|f| (spec.id.clone(), f)));
         let svg = figure::plot(&spec.chart(&plot))?;
-        outcome.ran.push((spec.id.clone(), csv, svg));
+        outcome.ran.push((spec.id.clone(), run.csv, svg));
         overall.inc(1);
     }
     overall.finish_and_clear();

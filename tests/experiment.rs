@@ -196,7 +196,7 @@ modles = ["a"]"#,
 fn quick_run_writes_one_row_per_measurement_matching_evaluate() {
     let root = tempfile::tempdir().unwrap();
     let spec_path = common::write_spec(root.path(), "tiny", TINY);
-    let csv = run(&spec_path, &quick(root.path())).unwrap();
+    let csv = run(&spec_path, &quick(root.path())).unwrap().csv;
     assert_eq!(csv, root.path().join("results/quick/tiny.csv"));
     let (header, rows) = read_csv(&csv);
     assert_eq!(header, COLUMNS);
@@ -282,7 +282,7 @@ fn per_view_rows_are_written_when_the_figure_draws_them() {
         "kind = \"distribution\"\nmetric = \"ovr\"\nfacet = \"model\"",
     );
     let path = common::write_spec(root.path(), "spread", &text);
-    let (_, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
+    let (_, rows) = read_csv(&run(&path, &quick(root.path())).unwrap().csv);
     let spec = Spec::load(&path).unwrap();
     let work = spec.workload(true).unwrap();
     let options =
@@ -388,22 +388,42 @@ fn missing_models_are_refused_before_any_work() {
 }
 
 #[test]
-fn a_failed_run_leaves_the_previous_results_whole() {
+fn a_broken_model_is_recorded_and_the_run_goes_on() {
     let root = tempfile::tempdir().unwrap();
-    let path = common::write_spec(root.path(), "tiny", TINY);
-    let opts = RunOptions { out_dir: root.path().into(), ..RunOptions::default() };
-    let csv = run(&path, &opts).unwrap();
-    assert_eq!(csv, root.path().join("results/tiny.csv"));
-    let before = std::fs::read(&csv).unwrap();
-    // The second model exists but is not a valid mesh: the run fails after the first model's work.
+    // The first model exists but is not a valid mesh: it becomes an error row, and the second
+    // model is measured as in a run without it.
     let broken = root.path().join("broken.obj");
     std::fs::write(&broken, "v 0 0 0\nf 1 2 3\n").unwrap();
-    let models = format!("models = [\"sphere:80\", \"{}\"]", broken.display());
-    std::fs::write(&path, TINY.replacen("models = [\"sphere:80\", \"grid:4x4\"]", &models, 1)).unwrap();
-    let err = run(&path, &opts).unwrap_err().to_string();
-    assert!(err.contains("broken.obj"), "{err}");
-    assert_eq!(std::fs::read(&csv).unwrap(), before, "the previous CSV is untouched");
-    let files: Vec<_> = std::fs::read_dir(csv.parent().unwrap()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let models = format!("models = [\"{}\", \"sphere:80\"]", broken.display());
+    let path =
+        common::write_spec(root.path(), "tiny", &TINY.replacen("models = [\"sphere:80\", \"grid:4x4\"]", &models, 1));
+    let opts = RunOptions { out_dir: root.path().into(), ..RunOptions::default() };
+    let outcome = run(&path, &opts).unwrap();
+    assert_eq!(outcome.failures.len(), 1, "{:?}", outcome.failures);
+    let failure = &outcome.failures[0];
+    assert!(failure.model.ends_with("broken.obj") && failure.method.is_none());
+    assert!(failure.reason.contains("broken.obj") && failure.reason.contains("out of range"), "{}", failure.reason);
+    let (_, rows) = read_csv(&outcome.csv);
+    let errors: Vec<_> = rows.iter().filter(|r| r["metric"] == "error").collect();
+    assert_eq!(errors.len(), 1, "one row for the model, not one per method");
+    assert_eq!(errors[0]["error"], failure.reason);
+    assert!(errors[0]["method"].is_empty());
+    // The sphere's rows are those of a run that never named the broken model.
+    let alone = common::write_spec(
+        root.path(),
+        "tiny",
+        TINY.replacen("models = [\"sphere:80\", \"grid:4x4\"]", "models = [\"sphere:80\"]", 1).as_str(),
+    );
+    let measured = |rows: &[HashMap<String, String>]| -> Vec<(String, String, String, String)> {
+        rows.iter()
+            .filter(|r| r["metric"] != "error" && r["metric"] != "seconds")
+            .map(|r| (r["method"].clone(), r["metric"].clone(), r["cache"].clone(), r["value"].clone()))
+            .collect()
+    };
+    let (_, sphere_rows) = read_csv(&run(&alone, &opts).unwrap().csv);
+    assert_eq!(measured(&rows), measured(&sphere_rows));
+    let files: Vec<_> =
+        std::fs::read_dir(outcome.csv.parent().unwrap()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(files, ["tiny.csv"], "no temporary file is left behind");
 }
 
@@ -514,7 +534,7 @@ models = ["assets/Fox.glb#frames=2", "sphere:80"]
 fn animated_runs_write_buffers_and_a_row_per_clip() {
     let root = tempfile::tempdir().unwrap();
     let path = common::write_spec(root.path(), "animated", ANIMATED);
-    let (header, rows) = read_csv(&run(&path, &quick(root.path())).unwrap());
+    let (header, rows) = read_csv(&run(&path, &quick(root.path())).unwrap().csv);
     assert_eq!(header, COLUMNS);
     let find = |model: &str, method: &str, metric: &str, clip: &str| {
         let found: Vec<f64> = rows

@@ -153,7 +153,7 @@ facet = "model"
             backend: Some(backend.into()),
             ..Default::default()
         };
-        let csv = triorder::experiment::run(&spec, &options).unwrap();
+        let csv = triorder::experiment::run(&spec, &options).unwrap().csv;
         common::csv_rows(&csv)
             .into_iter()
             .map(|r| (r["backend"].clone(), r["metric"].clone(), r["value"].clone()))

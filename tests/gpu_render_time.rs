@@ -72,7 +72,7 @@ facet = "model"
 "#;
     let spec = common::write_spec(root.path(), "tiny-time", text);
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
-    let csv = triorder::experiment::run(&spec, &options).unwrap();
+    let csv = triorder::experiment::run(&spec, &options).unwrap().csv;
     let rows = common::csv_rows(&csv);
     let timed: Vec<_> = rows.iter().filter(|r| r["metric"].starts_with("render_")).collect();
     // 2 models × 2 methods × (mean + spread + 6 views).

@@ -86,7 +86,7 @@ facet = "model"
 "#;
     let spec = common::write_spec(root.path(), "tiny-hw", text);
     let options = triorder::experiment::RunOptions { out_dir: root.path().into(), ..Default::default() };
-    let csv = triorder::experiment::run(&spec, &options).unwrap();
+    let csv = triorder::experiment::run(&spec, &options).unwrap().csv;
     let rows = common::csv_rows(&csv);
     let counted: Vec<_> = rows.iter().filter(|r| r["cache"] == "gpu").collect();
     // Two models × two methods × (acmr, atvr), each naming the device that counted it.
@@ -95,6 +95,6 @@ facet = "model"
     assert_eq!(counted.iter().filter(|r| r["metric"] == "acmr").count(), 4);
     // A method with several buffers is counted over its draws like any other.
     std::fs::write(&spec, text.replace(r#"["input", "random"]"#, r#"["hs17:views=12,res=32"]"#)).unwrap();
-    let rows = common::csv_rows(&triorder::experiment::run(&spec, &options).unwrap());
+    let rows = common::csv_rows(&triorder::experiment::run(&spec, &options).unwrap().csv);
     assert_eq!(rows.iter().filter(|r| r["cache"] == "gpu").count(), 4);
 }

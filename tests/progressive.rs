@@ -281,7 +281,7 @@ models = ["disk:950"]
 "#;
     let path = common::write_spec(root.path(), "levels", text);
     let options = RunOptions { quick: true, out_dir: root.path().to_path_buf(), ..RunOptions::default() };
-    let csv = run(&path, &options).unwrap();
+    let csv = run(&path, &options).unwrap().csv;
     let mut reader = csv::Reader::from_path(&csv).unwrap();
     let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
     let column = |name: &str| header.iter().position(|h| h == name).unwrap();

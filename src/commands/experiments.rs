@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use triorder::Result;
-use triorder::experiment::{self, RunOptions, provenance};
+use triorder::experiment::shard::Shard;
+use triorder::experiment::{self, Failure, RunOptions, provenance};
 use triorder::figure::PlotOptions;
 use triorder::mesh::{Source, source};
 use triorder::reproduce;
@@ -11,7 +12,7 @@ use triorder::{measure, raster};
 
 use crate::{BenchPart, Common};
 
-/// Options for `run` and `reproduce`; an unknown backend fails here, before any spec runs.
+/// Options for `run`, `merge` and `reproduce`; an unknown backend fails here, before any spec runs.
 fn run_options(quick: bool, backend: Option<String>, common: &Common) -> Result<RunOptions> {
     if let Some(name) = &backend {
         measure::check_backend_name(name)?;
@@ -19,10 +20,55 @@ fn run_options(quick: bool, backend: Option<String>, common: &Common) -> Result<
     Ok(RunOptions { quick, data: common.data.clone(), progress: true, backend, ..Default::default() })
 }
 
-pub fn run(spec: &Path, quick: bool, backend: Option<String>, common: &Common) -> Result<()> {
-    let csv = experiment::run(spec, &run_options(quick, backend, common)?)?;
-    println!("wrote {}", csv.display());
+pub fn run(spec: &Path, quick: bool, backend: Option<String>, shard: Option<&str>, common: &Common) -> Result<()> {
+    let shard = shard.map(str::parse::<Shard>).transpose()?;
+    let outcome = experiment::run(spec, &RunOptions { shard, ..run_options(quick, backend, common)? })?;
+    let share = match shard {
+        Some(shard) => format!(" (shard {shard}: {} of {} units)", outcome.units, outcome.total_units),
+        None => String::new(),
+    };
+    if outcome.skipped {
+        println!("{} is complete for this spec and version: skipped{share}", outcome.csv.display());
+        return Ok(());
+    }
+    println!("wrote {}{share}", outcome.csv.display());
+    print!("{}", failures(outcome.failures.iter().map(|f| ("", f)), &outcome.csv));
     Ok(())
+}
+
+pub fn merge(spec: &Path, quick: bool, shards: Option<usize>, common: &Common) -> Result<()> {
+    let merged = experiment::merge(spec, &run_options(quick, None, common)?, shards)?;
+    println!("wrote {} ({} rows from {} shards)", merged.csv.display(), merged.rows, merged.shards);
+    Ok(())
+}
+
+/// What failed in a run and went on without, a line each (at most 20, then a count); empty when
+/// nothing failed. `spec` prefixes each line in a reproduction (the spec's id).
+fn failures<'a>(failed: impl Iterator<Item = (&'a str, &'a Failure)>, csv: &Path) -> String {
+    let failed: Vec<_> = failed.collect();
+    if failed.is_empty() {
+        return String::new();
+    }
+    let models: std::collections::BTreeSet<&str> = failed.iter().map(|(_, f)| f.model.as_str()).collect();
+    let mut out = format!(
+        "{} failure(s) in {} model(s), recorded as `error` rows in {} (the run went on without them):\n",
+        failed.len(),
+        models.len(),
+        csv.display()
+    );
+    const SHOWN: usize = 20;
+    for (spec, f) in failed.iter().take(SHOWN) {
+        let spec = if spec.is_empty() { String::new() } else { format!("{spec}: ") };
+        let method = f.method.as_ref().map_or(String::new(), |m| format!("with {m}: "));
+        let reason = f.reason.lines().next().unwrap_or_default();
+        // Most reasons start with the file's path already.
+        let model = if reason.contains(&f.model) { String::new() } else { format!("{}: ", f.model) };
+        out += &format!("  {spec}{model}{method}{reason}\n");
+    }
+    if failed.len() > SHOWN {
+        out += &format!("  … and {} more\n", failed.len() - SHOWN);
+    }
+    out
 }
 
 pub fn plot(spec: &Path, quick: bool, common: &Common) -> Result<()> {
@@ -53,6 +99,10 @@ fn summary(outcome: &reproduce::Outcome, quick: bool) -> String {
     for (id, why) in &outcome.skipped {
         out += &format!("  skipped {id}: {why}\n");
     }
+    out += &failures(
+        outcome.failures.iter().map(|(id, f)| (id.as_str(), f)),
+        Path::new(&format!("results{}/", if quick { "/quick" } else { "" })),
+    );
     if let Some(device) = &outcome.device {
         out += &format!("  GPU specs ran on {device}\n");
     }

@@ -4,7 +4,7 @@
 mod experiments;
 mod tables;
 
-pub use experiments::{bench, plot, reproduce, run};
+pub use experiments::{bench, merge, plot, reproduce, run};
 
 use std::path::Path;
 

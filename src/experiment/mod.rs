@@ -3,9 +3,13 @@
 //! for every spec. [`bench`] times our metrics and orderings against meshoptimizer.
 
 pub mod bench;
+pub mod corpus;
+pub mod merge;
 pub mod provenance;
 pub mod run;
+pub mod shard;
 pub mod spec;
 
-pub use run::{RunOptions, run};
+pub use merge::merge;
+pub use run::{Failure, Outcome, RunOptions, run};
 pub use spec::Spec;

@@ -13,16 +13,19 @@ use std::path::{Path, PathBuf};
 use base64::Engine;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::corpus;
 use super::provenance;
-use super::spec::Spec;
+use super::shard::{self, Shard, Unit};
+use super::spec::{Model, Spec};
 use crate::atomic;
 use crate::error::{Error, Result};
 use crate::figure::spec::FigureKind;
 use crate::measure::{self, Evaluation, cache};
+use crate::mesh::progressive::Update;
 use crate::mesh::{Mesh, Scene, source};
-use crate::order::{self, Clustered};
+use crate::order::{self, Clustered, Resolved};
 use crate::raster::{cpu, views};
-use crate::results::{Context, OrderRow, Row};
+use crate::results::{COLUMNS, Context, ORDER_COLUMNS, OrderRow, Row};
 
 /// How to run experiments.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -37,29 +40,138 @@ pub struct RunOptions {
     pub out_dir: PathBuf,
     /// Raster backend for every spec, overriding each spec's `backend` (`cpu` or `gpu`).
     pub backend: Option<String>,
+    /// Run only this shard of the spec's units, into its own file ([`shard`]).
+    pub shard: Option<Shard>,
 }
 
 impl Default for RunOptions {
     fn default() -> Self {
-        RunOptions { quick: false, data: None, progress: false, out_dir: PathBuf::from("."), backend: None }
+        RunOptions {
+            quick: false,
+            data: None,
+            progress: false,
+            out_dir: PathBuf::from("."),
+            backend: None,
+            shard: None,
+        }
     }
 }
 
-/// Runs the spec at `spec` and writes its CSV; returns the CSV's path.
-pub fn run(spec: &Path, opts: &RunOptions) -> Result<PathBuf> {
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// The file written: the results CSV, or the shard's file.
+    pub csv: PathBuf,
+    /// The units this run did, and how many the spec has.
+    pub units: usize,
+    pub total_units: usize,
+    /// Each model that could not be loaded, or (model, method) that could not be ordered or
+    /// measured; the CSV has an `error` row for each.
+    pub failures: Vec<Failure>,
+    /// The shard's file was already complete for this spec and version: nothing ran.
+    pub skipped: bool,
+}
+
+/// A model, or a model and method, that failed; the run went on without it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Failure {
+    pub model: String,
+    /// `None` when the model itself could not be loaded.
+    pub method: Option<String>,
+    pub reason: String,
+}
+
+/// Runs the spec at `spec` and writes its CSV (or the shard's file).
+pub fn run(spec: &Path, opts: &RunOptions) -> Result<Outcome> {
     let spec = Spec::load(spec)?;
     run_spec(&spec, opts, &bars(opts.progress))
 }
 
-/// Runs a loaded spec, showing its progress bar among `bars`; returns the CSV's path.
-pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<PathBuf> {
+/// What a run of a spec works through: its models (corpora expanded), methods and updates, the
+/// units they make, and the fingerprint a shard records.
+pub(crate) struct Plan<'a> {
+    pub models: Vec<Model>,
+    pub methods: Vec<Resolved>,
+    pub updates: &'a [Update],
+    pub units: Vec<Unit>,
+    pub fingerprint: String,
+}
+
+impl<'a> Plan<'a> {
+    /// The plan of `spec` under `opts`; every model the spec names itself must exist.
+    pub fn new(spec: &'a Spec, opts: &RunOptions) -> Result<Plan<'a>> {
+        let work = spec.workload(opts.quick)?;
+        let data = source::data_dir(opts.data.as_deref());
+        let key = if opts.quick { "quick.models" } else { "models" };
+        let models = corpus::expand(&work.models, data.as_deref(), key).map_err(|e| Error::spec(&spec.path, e))?;
+        let methods = spec.methods.iter().map(|m| order::resolve(m, spec.seed)).collect::<Result<Vec<_>>>()?;
+        // Without levels the one update is never used.
+        let updates = if work.levels.is_empty() { &spec.updates[..1] } else { &spec.updates[..] };
+        let units = shard::units(models.len(), updates.len(), methods.len());
+        let names: Vec<String> = models.iter().map(|m| m.name.clone()).collect();
+        let fingerprint = shard::fingerprint(&spec.text, opts.quick, opts.backend.as_deref(), &names);
+        Ok(Plan { models, methods, updates, units, fingerprint })
+    }
+
+    /// The units `shard` does: those [`shard::assign`] gives it by estimated cost.
+    fn share(&self, spec: &Spec, opts: &RunOptions, shard: Shard) -> Result<Vec<usize>> {
+        let work = spec.workload(opts.quick)?;
+        let data = source::data_dir(opts.data.as_deref());
+        let options = spec.measure_options(work);
+        let triangles: Vec<f64> =
+            self.models.iter().map(|m| shard::estimated_triangles(&m.source, data.as_deref())).collect();
+        let costs: Vec<f64> = self
+            .units
+            .iter()
+            .map(|u| {
+                shard::unit_cost(triangles[u.model], self.methods[u.method].method.cost, &options, work.levels.len())
+            })
+            .collect();
+        let setup: Vec<f64> = triangles.iter().map(|&t| shard::setup_cost(t, work.levels.len())).collect();
+        let shard_of = shard::assign(&self.units, &costs, &setup, shard.count);
+        Ok((0..self.units.len()).filter(|&u| shard_of[u] == shard.index - 1).collect())
+    }
+}
+
+/// Whether a failure is the model's or method's own, to be recorded while the run goes on,
+/// rather than the machine's (no GPU, an unwritable output), which stops it.
+fn recorded(e: &Error) -> bool {
+    !matches!(e, Error::Gpu(_) | Error::Output { .. })
+}
+
+/// Runs a loaded spec, showing its progress bar among `bars`.
+pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Outcome> {
     let work = spec.workload(opts.quick)?;
     let data = source::data_dir(opts.data.as_deref());
-    let models_key = if opts.quick { "quick.models" } else { "models" };
-    for (i, model) in work.models.iter().enumerate() {
-        model.source.check(data.as_deref()).map_err(|e| Error::spec(&spec.path, format!("{models_key}[{i}]: {e}")))?;
+    let plan = Plan::new(spec, opts)?;
+    let csv = spec.csv_path(&opts.out_dir, opts.quick);
+    let orders_csv = spec.orders_path(&opts.out_dir, opts.quick);
+    let draws = spec.figure.kind.draws_meshes();
+    let mine = match opts.shard {
+        None => (0..plan.units.len()).collect(),
+        Some(shard) => plan.share(spec, opts, shard)?,
+    };
+    let header = opts.shard.map(|shard| shard::Header {
+        shard,
+        spec: spec.id.clone(),
+        fingerprint: plan.fingerprint.clone(),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        units: plan.units.len(),
+        mine: mine.clone(),
+    });
+    let outcome = |csv: PathBuf, failures: Vec<Failure>, skipped: bool| Outcome {
+        csv,
+        units: mine.len(),
+        total_units: plan.units.len(),
+        failures,
+        skipped,
+    };
+    if let (Some(header), Some(shard)) = (&header, opts.shard) {
+        let done = |path: &Path| Ok::<_, Error>(shard::Header::read(path).ok().flatten().as_ref() == Some(header));
+        if done(&shard::path(&csv, shard))? && (!draws || done(&shard::path(&orders_csv, shard))?) {
+            return Ok(outcome(shard::path(&csv, shard), Vec::new(), true));
+        }
     }
-    let methods = spec.methods.iter().map(|m| order::resolve(m, spec.seed)).collect::<Result<Vec<_>>>()?;
     let raster = measure::backend(opts.backend.as_deref().unwrap_or(&spec.backend))?;
     let options = spec.measure_options(work);
     let context = Context {
@@ -72,52 +184,109 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
     };
     // Buffer counts are reported where they can differ between the methods compared: for an
     // animation, and for every model when some method gives several buffers.
-    let per_node = methods.iter().any(|m| m.method.per_node);
+    let per_node = plan.methods.iter().any(|m| m.method.per_node);
 
-    let updates = if work.levels.is_empty() { 1 } else { spec.updates.len() };
-    let bar = bars.add(ProgressBar::new((work.models.len() * methods.len() * updates) as u64));
+    let bar = bars.add(ProgressBar::new(mine.len() as u64));
     bar.set_style(style("{prefix} {pos}/{len} {bar:30} {elapsed} {wide_msg}"));
-    bar.set_prefix(spec.id.clone());
-    let mut rows: Vec<Row> = Vec::new();
-    let mut orders: Vec<OrderRow> = Vec::new();
-    for model in &work.models {
+    bar.set_prefix(match opts.shard {
+        Some(shard) => format!("{} shard {shard}", spec.id),
+        None => spec.id.clone(),
+    });
+    let mut rows: Vec<(usize, Row)> = Vec::new();
+    let mut orders: Vec<(usize, OrderRow)> = Vec::new();
+    let mut failures: Vec<Failure> = Vec::new();
+    let per_model = plan.updates.len() * plan.methods.len();
+    for (m, model) in plan.models.iter().enumerate() {
+        let todo: Vec<usize> = mine.iter().copied().filter(|&u| plan.units[u].model == m).collect();
+        let Some(&first) = todo.first() else { continue };
+        let failed = failures.len();
         bar.set_message(format!("{}: loading", model.name));
-        let mut scene = model.source.open(data.as_deref(), spec.seed)?;
-        for warning in scene.report().warnings() {
-            bars.suspend(|| eprintln!("{}: note: {warning}", model.name));
-        }
-        if !work.levels.is_empty() {
-            bar.set_message(format!("{}: simplifying", model.name));
-            scene = scene.with_levels(&work.levels, spec.updates[0])?;
-            if let Some(note) = scene.frames.levels().and_then(|l| l.note.as_ref()) {
-                bars.suspend(|| eprintln!("{}: note: {note}", model.name));
-            }
-        }
-        // Without levels the one update is never used.
-        let updates = if work.levels.is_empty() { &spec.updates[..1] } else { &spec.updates[..] };
-        for &update in updates {
-            scene.set_update(update);
-            for method in &methods {
-                bar.set_message(format!("{} · {}", model.name, method.canonical()));
-                let evaluation = measure::evaluate(&scene, method, &options, raster.as_ref())?;
-                let buffers = per_node || scene.frames.is_animation();
-                rows.extend(context.rows(&model.name, &model.source, &scene, &evaluation, buffers));
-                if spec.figure.kind.draws_meshes() {
-                    orders.extend(drawn(spec, &model.name, &scene, &evaluation, &options.caches)?);
+        let scene = match open(spec, model, &work.levels, data.as_deref(), bars) {
+            Ok(scene) => scene,
+            Err(e) if recorded(&e) => {
+                let reason = e.to_string();
+                // One row per model, written by the run that has its first unit, so that the
+                // shards of a run together hold what the unsharded run holds.
+                if first == m * per_model {
+                    rows.push((first, context.error_row(&model.name, &model.source, None, &reason)));
                 }
-                bar.inc(1);
+                failures.push(Failure { model: model.name.clone(), method: None, reason });
+                bar.inc(todo.len() as u64);
+                continue;
             }
+            Err(e) => return Err(e),
+        };
+        let mut scene = scene;
+        for u in todo {
+            let unit = plan.units[u];
+            let method = &plan.methods[unit.method];
+            scene.set_update(plan.updates[unit.update]);
+            bar.set_message(format!("{} · {}", model.name, method.canonical()));
+            let measured = measure::evaluate(&scene, method, &options, raster.as_ref()).and_then(|evaluation| {
+                let buffers = per_node || scene.frames.is_animation();
+                let drawn =
+                    if draws { drawn(spec, &model.name, &scene, &evaluation, &options.caches)? } else { Vec::new() };
+                Ok((context.rows(&model.name, &model.source, &scene, &evaluation, buffers), drawn))
+            });
+            match measured {
+                Ok((new_rows, drawn)) => {
+                    rows.extend(new_rows.into_iter().map(|r| (u, r)));
+                    orders.extend(drawn.into_iter().map(|o| (u, o)));
+                }
+                Err(e) if recorded(&e) => {
+                    let reason = e.to_string();
+                    rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
+                    failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
+                }
+                Err(e) => return Err(e),
+            }
+            bar.inc(1);
+        }
+        if failures.len() > failed {
+            bar.set_prefix(format!(
+                "{} ({} failed)",
+                bar.prefix().split(" (").next().unwrap_or_default(),
+                failures.len()
+            ));
         }
     }
     bar.finish_and_clear();
     bars.remove(&bar);
 
-    if spec.figure.kind.draws_meshes() {
-        write_csv(&spec.orders_path(&opts.out_dir, opts.quick), &orders)?;
+    let written = match (&header, opts.shard) {
+        (Some(header), Some(shard)) => {
+            if draws {
+                shard::write(&shard::path(&orders_csv, shard), header, ORDER_COLUMNS, &orders)?;
+            }
+            let path = shard::path(&csv, shard);
+            shard::write(&path, header, COLUMNS, &rows)?;
+            path
+        }
+        _ => {
+            if draws {
+                write_csv(&orders_csv, orders.iter().map(|(_, o)| o))?;
+            }
+            write_csv(&csv, rows.iter().map(|(_, r)| r))?;
+            csv
+        }
+    };
+    Ok(outcome(written, failures, false))
+}
+
+/// Opens `model` for a run: loads or builds it, says what its report warns of, and simplifies it
+/// into `levels` when the spec measures progressive levels.
+fn open(spec: &Spec, model: &Model, levels: &[f64], data: Option<&Path>, bars: &MultiProgress) -> Result<Scene> {
+    let mut scene = model.source.open(data, spec.seed)?;
+    for warning in scene.report().warnings() {
+        bars.suspend(|| eprintln!("{}: note: {warning}", model.name));
     }
-    let path = spec.csv_path(&opts.out_dir, opts.quick);
-    write_csv(&path, &rows)?;
-    Ok(path)
+    if !levels.is_empty() {
+        scene = scene.with_levels(levels, spec.updates[0])?;
+        if let Some(note) = scene.frames.levels().and_then(|l| l.note.as_ref()) {
+            bars.suspend(|| eprintln!("{}: note: {note}", model.name));
+        }
+    }
+    Ok(scene)
 }
 
 /// What a drawing of `evaluation` needs beyond the geometry: the order and its clusters, and for
@@ -193,7 +362,7 @@ fn drawn_one(
 }
 
 /// Writes `rows` as CSV to `path` atomically, creating its directory.
-fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
+fn write_csv<'r, T: serde::Serialize + 'r>(path: &Path, rows: impl IntoIterator<Item = &'r T>) -> Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| Error::output(path, e))?;
     }

@@ -19,6 +19,10 @@
 //!                                  # TRIORDER_DATA, ../shared/data) or procedural specs; an
 //!                                  # animation is PATH#clip=NAME,frames=N,subdiv=L (every method
 //!                                  # measured over its keyframes, rows per clip)
+//!                                  # or a corpus, expanded when the run starts: a folder
+//!                                  # ("corpus/": every OBJ, PLY, glTF, GLB under it), a glob
+//!                                  # ("corpus/**/*.ply") or a list file ("corpus.txt", a model
+//!                                  # per line); see experiment/corpus.rs
 //! methods = "all"                  # every registered method with its defaults, or a list of
 //!                                  # method specs; any parameter may be a grid:
 //!                                  # ["input", "meshopt-fifo:cache={8,16,32}", "random:seed={1..3}"]
@@ -117,6 +121,8 @@ const MAX_EXPANSION: usize = 10_000;
 pub struct Spec {
     /// The file it was loaded from (errors name it).
     pub path: PathBuf,
+    /// The TOML as written: a sharded run's fingerprint hashes it.
+    pub text: String,
     pub id: String,
     pub title: String,
     pub question: String,
@@ -172,7 +178,7 @@ impl Spec {
         // An editor's UTF-8 byte-order mark is not part of the first key.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let raw: RawSpec = toml::from_str(text).map_err(|e| Error::spec(path, e.to_string().trim_end()))?;
-        raw.check(path)
+        Ok(Spec { text: text.to_string(), ..raw.check(path)? })
     }
 
     /// What a run measures: the `[quick]` table's workload when `quick`.
@@ -415,6 +421,7 @@ impl RawSpec {
         }
         Ok(Spec {
             path: path.to_path_buf(),
+            text: String::new(),
             id: self.id,
             title: self.title,
             question: self.question,
@@ -610,7 +617,13 @@ fn varies(full: &Workload, quick: Option<&Workload>, methods: &[String], updates
     let per_level: fn(&str) -> bool = |m| !crate::measure::ORDERING.iter().any(|n| n.name == m);
     let model_columns = &["model", "model_base", "model_triangles", "model_vertices", "source:"][..];
     [
-        (most(|w| w.models.len()), "models", model_columns, every),
+        // A corpus entry names many models (how many is known only when the run starts).
+        (
+            most(|w| w.models.iter().map(|m| if super::corpus::is_corpus(&m.name) { 2 } else { 1 }).sum()),
+            "models",
+            model_columns,
+            every,
+        ),
         (methods.len(), "methods", &["method", "method_name", "seed", "peer", "param:"][..], every),
         (most(|w| w.caches.len()), "cache models", &["cache", "cache_kind", "cache_size"][..], per_cache),
         (most(|w| w.levels.len()), "levels", &["level", "model_triangles", "model_vertices"][..], per_level),

@@ -91,6 +91,12 @@ pub fn check(spec: &str) -> Option<Result<()>> {
     shape(spec).map(|s| s.map(drop))
 }
 
+/// The triangles `spec` will have, without building it; `None` when it is not a valid procedural
+/// spec (a sharded run's cost estimate needs the count before the mesh).
+pub fn triangle_count(spec: &str) -> Option<u64> {
+    shape(spec)?.ok()?.triangles()
+}
+
 /// The mesh named by `spec`, or `None` if `spec` does not start with `grid:`, `disk:`,
 /// `sphere:`, `helix:` or `layers:` (then it is a file path). `seed` is used by `disk` only.
 /// The mesh is named `spec`; a malformed spec gives an [`Error::Input`] naming it and showing

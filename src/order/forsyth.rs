@@ -51,7 +51,7 @@
 //! and fall back to input order only when no vertex that has been touched has triangles left (a
 //! fresh component).
 
-use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 use crate::mesh::topology::Csr;
@@ -76,6 +76,7 @@ pub static METHOD: Method = Method {
     source: "Forsyth 2006, Linear-Speed Vertex Cache Optimisation",
     peer: false,
     per_node: false,
+    cost: Cost::Linear,
     params: &[CACHE, SCORES],
     build,
 };

@@ -14,7 +14,7 @@
 
 use glam::Vec3;
 
-use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::Framing;
 use crate::mesh::Scene;
@@ -33,6 +33,7 @@ pub static METHOD: Method = Method {
     source: "Nehab, Barczak & Sander 2006, §1 and Fig. 1a (the depth-sorted reference)",
     peer: false,
     per_node: false,
+    cost: Cost::Linear,
     params: &[X, Y, Z],
     build,
 };

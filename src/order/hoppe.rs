@@ -55,7 +55,7 @@
 
 use std::collections::VecDeque;
 
-use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 use crate::mesh::topology::{Csr, LiveLists, NONE, copies, edge_neighbors};
@@ -66,6 +66,7 @@ pub static METHOD: Method = Method {
     source: "Hoppe 1999, greedy strip growing; author's MeshReorder meshify5",
     peer: false,
     per_node: false,
+    cost: Cost::Heavy,
     params: &[CACHE],
     build,
 };

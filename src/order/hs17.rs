@@ -46,7 +46,7 @@ use rayon::prelude::*;
 
 use super::sander07::{LAMBDA, patches};
 use super::tipsify::FIFO_CACHE;
-use super::{Clustered, Lookup, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Clustered, Lookup, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::{Frames, Scene};
 use crate::raster::cpu::{Fragment, fragments};
@@ -94,6 +94,7 @@ pub static METHOD: Method = Method {
     source: "Han & Sander 2017, §3 and Algorithm 1",
     peer: false,
     per_node: true,
+    cost: Cost::Heavy,
     params: &[
         CLUSTERS,
         LAMBDA,

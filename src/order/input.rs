@@ -1,7 +1,7 @@
 //! `input`: the triangles in the order the file stores them — the baseline every paper reports
 //! (Bogomjakov & Gotsman 2002, Table 2 "original"; Nehab et al. 2006 compare against it too).
 
-use super::{Method, Order, Ordering, Orders, Params};
+use super::{Cost, Method, Order, Ordering, Orders, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 
@@ -11,6 +11,7 @@ pub static METHOD: Method = Method {
     source: "baseline in every paper",
     peer: false,
     per_node: false,
+    cost: Cost::Trivial,
     params: &[],
     build,
 };

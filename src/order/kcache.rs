@@ -69,6 +69,7 @@ pub static METHOD: Method = Method {
     source: "Lin & Yu 2006, IEEE TVCG 12(4), K-Cache-Reorder; Sander et al. 2007, Fig. 1",
     peer: false,
     per_node: false,
+    cost: super::Cost::Heavy,
     params: &[CACHE],
     build,
 };

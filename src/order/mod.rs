@@ -50,8 +50,38 @@ pub struct Method {
     /// Declared so that what needs one order (`triorder order`, the drawings of a mesh in its
     /// draw order) can refuse the method before running it.
     pub per_node: bool,
+    /// How long it takes per triangle, by order of magnitude: what sharded runs balance by.
+    pub cost: Cost,
     pub params: &'static [ParamInfo],
     pub build: fn(&Params) -> Box<dyn Ordering>,
+}
+
+/// A method's time per triangle by order of magnitude, as measured on an AMD EPYC (2 threads) over
+/// the shared models (`universal-acmr-vs-cache`, the `seconds` rows): what a sharded run
+/// balances its shards by before anything has run (`experiment::shard`). A class, not a
+/// measurement: within a class methods differ by up to 3×, and the classes 10× and more.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cost {
+    /// A copy or a shuffle: input, random (about 0.01 µs per triangle).
+    Trivial,
+    /// One or a few linear passes: curves, strips, Tipsify, Forsyth, the meshopt peers (0.05–0.5 µs).
+    Linear,
+    /// Local searches or per-view work: Hoppe, K-cache, Han–Sander (1–3 µs).
+    Heavy,
+    /// Global optimizations: METIS cuts, minimum linear arrangement, Nehab's clustering (5–12 µs).
+    Heaviest,
+}
+
+impl Cost {
+    /// The class's typical time per triangle, in microseconds.
+    pub fn micros_per_triangle(self) -> f64 {
+        match self {
+            Cost::Trivial => 0.01,
+            Cost::Linear => 0.25,
+            Cost::Heavy => 2.0,
+            Cost::Heaviest => 8.0,
+        }
+    }
 }
 
 /// Declares a method's module, unless it lives in a family's folder (`family::method`).

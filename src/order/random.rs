@@ -5,7 +5,7 @@
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 
-use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 
@@ -15,6 +15,7 @@ pub static METHOD: Method = Method {
     source: "Bogomjakov & Gotsman 2002, Fig. 5; Nehab et al. 2006, Fig. 7-8",
     peer: false,
     per_node: false,
+    cost: Cost::Trivial,
     params: &[ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "random seed" }],
     build,
 };

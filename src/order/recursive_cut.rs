@@ -44,7 +44,7 @@
 use std::collections::VecDeque;
 use std::sync::Mutex;
 
-use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::Scene;
@@ -56,6 +56,7 @@ pub static METHOD: Method = Method {
     source: "Bogomjakov & Gotsman 2002, §2.1-2.2, Fig. 3",
     peer: false,
     per_node: false,
+    cost: Cost::Heaviest,
     params: &[ParamInfo { name: "seed", default: "", kind: ParamKind::Seed, help: "METIS random seed" }],
     build,
 };

@@ -21,7 +21,7 @@
 use glam::{DVec3, Vec3};
 
 use super::tipsify::{FIFO_CACHE, tipsify};
-use super::{Clustered, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Clustered, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::frames::unit_positions64;
 use crate::mesh::topology::Csr;
@@ -33,6 +33,7 @@ pub static METHOD: Method = Method {
     source: "Sander, Nehab & Barczak 2007, §3-5",
     peer: false,
     per_node: false,
+    cost: Cost::Linear,
     params: &[FIFO_CACHE, LAMBDA],
     build,
 };

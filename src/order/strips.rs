@@ -21,7 +21,7 @@
 //! strip would be an error, never a silently flipped triangle.
 
 use super::meshopt::order_from_index_buffer;
-use super::{Method, Ordering, Orders, Params};
+use super::{Cost, Method, Ordering, Orders, Params};
 use crate::error::{Error, Result};
 use crate::mesh::Scene;
 
@@ -31,6 +31,7 @@ pub static METHOD: Method = Method {
     source: "meshoptimizer via the meshopt crate (after Evans et al. 1996); Bogomjakov & Gotsman 2002, Table 2",
     peer: true,
     per_node: false,
+    cost: Cost::Linear,
     params: &[],
     build,
 };

@@ -14,7 +14,7 @@
 //! the start vertex is 0 and the cursor runs over vertex ids in order, so the result depends on
 //! vertex numbering, as in the paper.
 
-use super::{Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 use crate::mesh::topology::Csr;
@@ -25,6 +25,7 @@ pub static METHOD: Method = Method {
     source: "Sander, Nehab & Barczak 2007, §3 (Tipsify)",
     peer: false,
     per_node: false,
+    cost: Cost::Linear,
     params: &[FIFO_CACHE],
     build,
 };

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::sander07::{LAMBDA, dot_rule_sort, patches};
 use super::tipsify::FIFO_CACHE;
-use super::{Clustered, Lookup, Method, Ordering, Orders, Params};
+use super::{Clustered, Lookup, Cost, Method, Ordering, Orders, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 
@@ -22,6 +22,7 @@ pub static METHOD: Method = Method {
     source: "Han & Sander 2017, Table 1 \"Tipsify\" (Sander, Nehab & Barczak 2007 per frame)",
     peer: false,
     per_node: true,
+    cost: Cost::Linear,
     params: &[FIFO_CACHE, LAMBDA],
     build,
 };

@@ -43,6 +43,7 @@ pub const COLUMNS: &[&str] = &[
     "machine",
     "commit",
     "triorder",
+    "error",
 ];
 
 /// One measurement. Field order is the column order ([`COLUMNS`]); `None` writes an empty cell.
@@ -82,6 +83,8 @@ pub struct Row {
     pub machine: String,
     pub commit: String,
     pub triorder: &'static str,
+    /// On an `error` row, why the model could not be loaded or measured (the run went on).
+    pub error: Option<String>,
 }
 
 /// Where and with what a run happened: the columns shared by all its rows.
@@ -156,19 +159,52 @@ impl Context {
     /// The `seconds` row of an evaluation, which every other row of it copies.
     fn base(&self, model: &str, source: &Source, mesh: &Mesh, eval: &Evaluation) -> Row {
         Row {
-            experiment: self.experiment.clone(),
-            model: model.to_string(),
-            model_base: model_base(model, source),
             model_triangles: mesh.triangle_count(),
             model_vertices: mesh.vertex_count(),
-            clip: None,
-            level: None,
-            update: None,
             method: eval.method.clone(),
             method_name: eval.method_name.to_string(),
             peer: eval.peer,
+            value: eval.seconds,
+            seconds: eval.seconds,
+            ..self.blank(model, source, "seconds")
+        }
+    }
+
+    /// The row recording that `model` could not be loaded (`method` is `None`) or could not be
+    /// ordered or measured with `method`: metric `error`, no value, and the reason.
+    pub fn error_row(
+        &self,
+        model: &str,
+        source: &Source,
+        method: Option<&crate::order::Resolved>,
+        reason: &str,
+    ) -> Row {
+        Row {
+            method: method.map(|m| m.canonical()).unwrap_or_default(),
+            method_name: method.map(|m| m.method.name.to_string()).unwrap_or_default(),
+            peer: method.is_some_and(|m| m.method.peer),
+            value: f64::NAN,
+            error: Some(reason.to_string()),
+            ..self.blank(model, source, "error")
+        }
+    }
+
+    /// A row of `metric` about `model` carrying the run's context, everything else empty.
+    fn blank(&self, model: &str, source: &Source, metric: &'static str) -> Row {
+        Row {
+            experiment: self.experiment.clone(),
+            model: model.to_string(),
+            model_base: model_base(model, source),
+            model_triangles: 0,
+            model_vertices: 0,
+            clip: None,
+            level: None,
+            update: None,
+            method: String::new(),
+            method_name: String::new(),
+            peer: false,
             seed: self.seed,
-            metric: "seconds",
+            metric,
             cache: None,
             cache_kind: None,
             cache_size: None,
@@ -176,11 +212,12 @@ impl Context {
             res: None,
             view: None,
             backend: self.backend.clone(),
-            value: eval.seconds,
-            seconds: eval.seconds,
+            value: 0.0,
+            seconds: 0.0,
             machine: self.machine.clone(),
             commit: self.commit.clone(),
             triorder: env!("CARGO_PKG_VERSION"),
+            error: None,
         }
     }
 }
@@ -192,6 +229,9 @@ fn model_base(name: &str, source: &Source) -> String {
         _ => name.to_string(),
     }
 }
+
+/// The orders file's header, in order (checked against [`OrderRow`] by a test).
+pub const ORDER_COLUMNS: &[&str] = &["model", "method", "order", "clusters", "corners", "overdraw", "level", "update"];
 
 /// One line of a drawing spec's orders file: a whole order, the triangle ids in draw order
 /// separated by spaces (one line per order keeps the file a seventh of one row per triangle).
@@ -325,10 +365,25 @@ mod tests {
             machine: String::new(),
             commit: String::new(),
             triorder: "",
+            error: None,
         };
         let mut writer = csv::Writer::from_writer(Vec::new());
         writer.serialize(&row).unwrap();
         let text = String::from_utf8(writer.into_inner().unwrap()).unwrap();
         assert_eq!(text.lines().next().unwrap(), COLUMNS.join(","));
+        let order = OrderRow {
+            model: String::new(),
+            method: String::new(),
+            order: String::new(),
+            clusters: String::new(),
+            corners: String::new(),
+            overdraw: String::new(),
+            level: String::new(),
+            update: String::new(),
+        };
+        let mut writer = csv::Writer::from_writer(Vec::new());
+        writer.serialize(&order).unwrap();
+        let text = String::from_utf8(writer.into_inner().unwrap()).unwrap();
+        assert_eq!(text.lines().next().unwrap(), ORDER_COLUMNS.join(","));
     }
 }

@@ -26,7 +26,7 @@ use super::centroid_grid::CentroidGrid;
 use super::grid_walk::RegularGrid;
 use crate::error::Result;
 use crate::mesh::Scene;
-use crate::order::{Method, Order, Ordering, Orders, Params};
+use crate::order::{Cost, Method, Order, Ordering, Orders, Params};
 
 pub static METHOD: Method = Method {
     name: "hilbert",
@@ -34,6 +34,7 @@ pub static METHOD: Method = Method {
     source: "Bogomjakov & Gotsman 2002, §2.1, Fig. 2(b); gilbert for any grid size; non-grid generalisation ours",
     peer: false,
     per_node: false,
+    cost: Cost::Linear,
     params: &[],
     build,
 };

@@ -21,7 +21,7 @@ use super::centroid_grid::CentroidGrid;
 use super::grid_walk::RegularGrid;
 use crate::error::Result;
 use crate::mesh::Scene;
-use crate::order::{Method, Order, Ordering, Orders, Params};
+use crate::order::{Cost, Method, Order, Ordering, Orders, Params};
 
 pub static METHOD: Method = Method {
     name: "snake",
@@ -29,6 +29,7 @@ pub static METHOD: Method = Method {
     source: "Bogomjakov & Gotsman 2002, §2.1, Fig. 2(a); non-grid generalisation ours",
     peer: false,
     per_node: false,
+    cost: Cost::Linear,
     params: &[],
     build,
 };

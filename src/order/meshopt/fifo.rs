@@ -5,7 +5,7 @@
 use super::order_from_index_buffer;
 use crate::error::Result;
 use crate::mesh::Scene;
-use crate::order::{Method, Ordering, Orders, Params};
+use crate::order::{Cost, Method, Ordering, Orders, Params};
 
 pub static METHOD: Method = Method {
     name: "meshopt-fifo",
@@ -13,6 +13,7 @@ pub static METHOD: Method = Method {
     source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §3",
     peer: true,
     per_node: false,
+    cost: Cost::Linear,
     params: &[crate::order::tipsify::FIFO_CACHE],
     build,
 };

@@ -15,7 +15,7 @@ use super::order_from_index_buffer;
 use crate::error::Result;
 use crate::mesh::Scene;
 use crate::mesh::frames::unit_positions;
-use crate::order::{Method, Ordering, Orders, ParamInfo, ParamKind, Params};
+use crate::order::{Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 
 const THRESHOLD: ParamInfo = ParamInfo {
     name: "threshold",
@@ -30,6 +30,7 @@ pub static METHOD: Method = Method {
     source: "meshoptimizer via the meshopt crate; after Sander, Nehab & Barczak 2007, §4-5",
     peer: true,
     per_node: false,
+    cost: Cost::Linear,
     params: &[THRESHOLD],
     build,
 };

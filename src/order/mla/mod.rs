@@ -48,7 +48,7 @@
 pub mod arrangement;
 
 use super::recursive_cut::by_component;
-use super::{Method, Order, Ordering, Orders, Params};
+use super::{Cost, Method, Order, Ordering, Orders, Params};
 use crate::error::Result;
 use crate::mesh::Scene;
 use crate::mesh::topology::Topology;
@@ -59,6 +59,7 @@ pub static METHOD: Method = Method {
     source: "Bogomjakov & Gotsman 2002, §2.3; solver after Safro, Ron & Brandt 2006",
     peer: false,
     per_node: false,
+    cost: Cost::Heaviest,
     params: &[],
     build,
 };

@@ -24,7 +24,7 @@ use planar_clusters::planar_clusters;
 use rayon::prelude::*;
 
 use super::hoppe;
-use super::{Clustered, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::{Clustered, Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::Framing;
 use crate::mesh::{Mesh, Scene};
@@ -66,6 +66,7 @@ pub static METHOD: Method = Method {
     source: "Nehab, Barczak & Sander 2006, §3-5",
     peer: false,
     per_node: false,
+    cost: Cost::Heaviest,
     params: &[
         CLUSTERS,
         VIEWS,
