@@ -72,6 +72,32 @@ struct Measure {
     backend: String,
 }
 
+/// How `order` writes the asset.
+#[derive(Args, Clone)]
+struct Writing {
+    /// Also renumber vertices in first-use order (vertex-fetch locality), each primitive's
+    /// attributes and morph targets permuted together.
+    #[arg(long)]
+    remap_vertices: bool,
+    /// Fail, writing nothing, when the output format cannot hold everything the input does (an
+    /// animation written as OBJ, materials as PLY); without it that is one warning.
+    #[arg(long)]
+    strict: bool,
+}
+
+/// What `eval` orders and how it prints.
+#[derive(Args, Clone)]
+struct EvalReport {
+    /// One JSON object per method per line instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Order each draw call (glTF primitive, run of OBJ faces with one group and material) on its
+    /// own and measure the calls in sequence, as an engine draws the asset and as `order` writes
+    /// it. Without it the whole mesh is one order, as in the papers.
+    #[arg(long)]
+    draw_calls: bool,
+}
+
 /// Progressive levels to measure (`eval`) or write (`order`), for a static mesh.
 #[derive(Args, Clone, Default)]
 struct Progressive {
@@ -121,10 +147,16 @@ enum BenchPart {
 enum Command {
     /// List every ordering method with its parameters, defaults and source paper or library.
     Methods,
-    /// Reorder a mesh file and write it (OBJ, PLY or GLB, by extension), attributes preserved.
+    /// Reorder an asset for an engine: the same asset, only faster to draw.
     ///
-    /// Prints the ACMR before and after (and OVR with --views). The output is written
-    /// atomically: on any failure no partial file is left.
+    /// Each draw call (glTF primitive, run of OBJ faces with one group and material, a PLY) is
+    /// ordered on its own. Same format in and out keeps everything else: a glTF/GLB is rewritten
+    /// in place (nodes, skins, animations, morph targets, materials, every attribute and
+    /// extension kept; only index data, or vertex data with --remap-vertices, changes), an OBJ
+    /// keeps mtllib, usemtl, o, g and s, a PLY every element and property. Another output format
+    /// keeps one mesh and says in one warning what it cannot hold (--strict: an error). Prints
+    /// the ACMR of the draw calls in sequence before and after (and OVR with --views). Outputs
+    /// are written atomically: on any failure no partial file is left.
     ///
     /// With --levels it writes a progressive mesh (Bogomjakov & Gotsman 2002, §3): the mesh
     /// simplified to each fraction of its triangles, the method's sequence kept by --update. A
@@ -140,9 +172,8 @@ enum Command {
         /// Ordering method with parameters, e.g. meshopt-overdraw:threshold=1.05.
         #[arg(short, long, default_value = "meshopt-vcache")]
         method: String,
-        /// Also renumber vertices in first-use order (vertex-fetch locality).
-        #[arg(long)]
-        remap_vertices: bool,
+        #[command(flatten)]
+        writing: Writing,
         #[command(flatten)]
         measure: Measure,
         #[command(flatten)]
@@ -166,9 +197,8 @@ enum Command {
         animation: Animation,
         #[command(flatten)]
         progressive: Progressive,
-        /// One JSON object per method per line instead of a table.
-        #[arg(long)]
-        json: bool,
+        #[command(flatten)]
+        report: EvalReport,
     },
     /// Run an experiment spec (experiments/*.toml) and write results/ID.csv.
     Run {
@@ -242,11 +272,11 @@ fn main() -> ExitCode {
     triorder::mesh::gltf::allow_outside_uris(common.allow_outside_uris);
     let result = match cli.command {
         Command::Methods => commands::methods(),
-        Command::Order { input, output, method, remap_vertices, measure, progressive } => {
-            commands::order(&input, &output, &method, remap_vertices, &measure, &progressive, common)
+        Command::Order { input, output, method, writing, measure, progressive } => {
+            commands::order(&input, &output, &method, &writing, &measure, &progressive, common)
         }
-        Command::Eval { mesh, methods, measure, animation, progressive, json } => {
-            commands::eval(&mesh, &methods, &measure, &animation, &progressive, json, common)
+        Command::Eval { mesh, methods, measure, animation, progressive, report } => {
+            commands::eval(&mesh, &methods, &measure, &animation, &progressive, &report, common)
         }
         Command::Run { spec, quick, backend, shard } => commands::run(&spec, quick, backend, shard.as_deref(), common),
         Command::Merge { spec, quick, shards } => commands::merge(&spec, quick, shards, common),

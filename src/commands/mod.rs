@@ -1,6 +1,7 @@
 //! One function per subcommand. Each parses its strings into library types up front (so a bad
 //! method, cache or view set fails before any work), calls the library, and prints.
 
+mod asset;
 mod experiments;
 mod tables;
 
@@ -18,7 +19,7 @@ use triorder::order::{self, METHODS, Orders, params::describe_kind};
 use triorder::raster::{RasterBackend, ViewSet};
 use triorder::{Error, Result};
 
-use crate::{Animation, Common, Measure, Progressive};
+use crate::{Animation, Common, EvalReport, Measure, Progressive, Writing};
 
 /// Parsed measurement options plus the chosen backend.
 struct Measuring {
@@ -44,8 +45,16 @@ impl Measuring {
         if !(1..=MAX_FRAMES).contains(&m.render_frames) {
             return Err(Error::usage(format!("--render-frames {} is outside 1..={MAX_FRAMES}", m.render_frames)));
         }
-        let options =
-            MeasureOptions { caches, gpu_vertices, views, res: m.res, seed, render, render_frames: m.render_frames };
+        let options = MeasureOptions {
+            caches,
+            gpu_vertices,
+            views,
+            res: m.res,
+            seed,
+            render,
+            render_frames: m.render_frames,
+            per_draw_call: false,
+        };
         Ok(Measuring { options, raster })
     }
 }
@@ -87,10 +96,12 @@ pub fn eval(
     measure: &Measure,
     animation: &Animation,
     progressive: &Progressive,
-    json: bool,
+    report: &EvalReport,
     common: &Common,
 ) -> Result<()> {
-    let measuring = Measuring::new(measure, common.seed)?;
+    let json = report.json;
+    let mut measuring = Measuring::new(measure, common.seed)?;
+    measuring.options.per_draw_call = report.draw_calls;
     let specs: Vec<&str> =
         if methods.is_empty() { vec!["input"] } else { methods.iter().map(String::as_str).collect() };
     let resolved = specs.iter().map(|s| order::resolve(s, common.seed)).collect::<Result<Vec<_>>>()?;
@@ -147,11 +158,12 @@ pub fn order(
     source: &str,
     output: &Path,
     method: &str,
-    remap_vertices: bool,
+    writing: &Writing,
     measure: &Measure,
     progressive: &Progressive,
     common: &Common,
 ) -> Result<()> {
+    let (remap_vertices, strict) = (writing.remap_vertices, writing.strict);
     let measuring = Measuring::new(measure, common.seed)?;
     let resolved = order::resolve(method, common.seed)?;
     if resolved.method.per_node {
@@ -161,39 +173,44 @@ pub fn order(
     let source = Source::parse(source)?;
     if source.is_animation() {
         return Err(Error::usage(format!(
-            "`{source}`: `order` writes a static mesh and would drop the animation; \
-             name the file without `#...` to reorder its rest mesh"
+            "`{source}`: `order` writes the asset with its triangles reordered, animations kept; \
+             name the file without `#...`"
         )));
     }
     if output.is_dir() {
         return Err(Error::output(output, "is a directory"));
     }
-    if triorder::mesh::save::format_of(output).is_none() {
-        return Err(Error::output(output, "unknown output format (use .obj, .ply or .glb)"));
-    }
-    let mut scene = open(&source, common)?;
     if !progressive.levels.is_empty() {
-        scene = with_levels(scene, &progressive.levels, update)?;
+        if triorder::mesh::save::format_of(output).is_none() {
+            return Err(Error::output(output, "unknown output format for levels (use .obj, .ply or .glb)"));
+        }
+        let scene = with_levels(open(&source, common)?, &progressive.levels, update)?;
         return order_levels(scene, output, &resolved, remap_vertices, &measuring);
     }
-    let identity: Vec<u32> = (0..scene.mesh.triangle_count() as u32).collect();
-    let before = measure::measure(&scene, &Orders::from(identity), &measuring.options, measuring.raster.as_ref())?;
-    let after = measure::evaluate(&scene, &resolved, &measuring.options, measuring.raster.as_ref())?;
-    let buffer =
-        after.orders.single().ok_or_else(|| order::needs_one_order(after.method_name, "`order` cannot write it"))?;
-    let mut reordered = scene.mesh.reordered(&buffer.order);
-    if remap_vertices {
-        reordered = reordered.remap_vertices_first_use();
+    if !asset::writable(output) {
+        return Err(Error::output(output, "unknown output format (use .glb, .gltf, .obj or .ply)"));
     }
-    let saved = triorder::mesh::save::save(&reordered, output)?;
-    warn_dropped(output, &saved.dropped);
-    println!("{}", tables::before_after(&before, &after.measured));
+    let data = source::data_dir(common.data.as_deref());
+    let input = source.file(data.as_deref()).transpose()?;
+    let scene = open(&source, common)?;
+    let identity = |scene: &Scene| Orders::from((0..scene.mesh.triangle_count() as u32).collect::<Vec<_>>());
+    let (options, raster) = (&measuring.options, measuring.raster.as_ref());
+    let before = measure::measure(&scene, &identity(&scene), options, raster)?;
+    let written = asset::write(input.as_deref(), &scene, output, &resolved, remap_vertices, strict)?;
+    // The file as written, drawn as an engine draws it: its draw calls in sequence.
+    let out = Source::File(output.display().to_string()).open(None, common.seed)?;
+    let after = measure::measure(&out, &identity(&out), options, raster)?;
+    println!("{}", tables::before_after(&before, &after));
+    for note in &written.notes {
+        println!("note: {note}");
+    }
+    let calls = scene.draw_calls.len().max(1);
     println!(
-        "wrote {} ({} triangles, {} ordered in {:.3} s)",
+        "wrote {} ({} triangles in {calls} draw call(s), each ordered on its own by {} in {:.3} s)",
         output.display(),
-        reordered.triangle_count(),
-        after.method,
-        after.seconds
+        out.mesh.triangle_count(),
+        resolved.canonical(),
+        written.seconds
     );
     Ok(())
 }

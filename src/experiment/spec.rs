@@ -200,6 +200,8 @@ impl Spec {
             seed: self.seed,
             render: self.render.clone(),
             render_frames: work.render_frames,
+            // Specs measure whole meshes, as the papers do.
+            per_draw_call: false,
         }
     }
 

@@ -118,6 +118,9 @@ pub struct MeasureOptions {
     pub render: Vec<Shading>,
     /// Timed frames per view for `render`.
     pub render_frames: usize,
+    /// Order each of the scene's draw calls on its own and measure them in sequence, as an
+    /// engine draws an asset ([`order::draw_calls`]); otherwise the whole mesh, as the papers do.
+    pub per_draw_call: bool,
 }
 
 impl MeasureOptions {
@@ -349,7 +352,8 @@ pub fn evaluate(
     raster: &dyn RasterBackend,
 ) -> Result<Evaluation> {
     let start = Instant::now();
-    let orders = order::run(method, scene)?;
+    let orders =
+        if options.per_draw_call { order::draw_calls::run(method, scene)? } else { order::run(method, scene)? };
     let seconds = start.elapsed().as_secs_f64();
     let measured = measure(scene, &orders, options, raster)?;
     Ok(Evaluation {

@@ -16,6 +16,11 @@ use crate::mesh::{Mesh, gltf, obj, ply};
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LoadReport {
     pub dropped: Vec<String>,
+    /// The file's draw calls as ranges of the mesh's triangles, in order: one per glTF primitive
+    /// instance, per run of OBJ faces between statements that set a group, material or
+    /// smoothing group, one for a PLY. What an engine draws separately, and so what `order`
+    /// reorders each on its own.
+    pub draw_calls: Vec<std::ops::Range<usize>>,
 }
 
 /// Loads `path`, printing on stderr a warning for each thing the reader had to leave out.
@@ -23,11 +28,16 @@ pub struct LoadReport {
 /// This is the call for code that only wants the geometry; use [`load_file_with_report`] to
 /// handle the warnings yourself.
 pub fn load_file(path: &Path) -> Result<Mesh> {
+    load_file_with_draw_calls(path).map(|(mesh, _)| mesh)
+}
+
+/// [`load_file`], and the file's draw calls ([`LoadReport::draw_calls`]).
+pub fn load_file_with_draw_calls(path: &Path) -> Result<(Mesh, Vec<std::ops::Range<usize>>)> {
     let (mesh, report) = load_file_with_report(path)?;
     for dropped in &report.dropped {
         eprintln!("warning: {}: {dropped}", path.display());
     }
-    Ok(mesh)
+    Ok((mesh, report.draw_calls))
 }
 
 /// Loads `path` (`.obj`, `.ply`, `.glb` or `.gltf`, any case) and says what was left out. The

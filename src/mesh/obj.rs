@@ -37,7 +37,7 @@ pub fn read(bytes: &[u8], origin: &str) -> Result<(Mesh, LoadReport)> {
         return Err(Error::input(origin, "not an OBJ file: the file is empty"));
     }
     let checked = check(&text).map_err(|problem| Error::input(origin, problem))?;
-    let mut report = LoadReport { dropped: checked.dropped };
+    let mut report = LoadReport { dropped: checked.dropped, draw_calls: checked.draw_calls };
 
     let options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
     let no_materials = |_: &std::path::Path| Err(tobj::LoadError::OpenFileFailed);
@@ -65,6 +65,11 @@ pub fn read(bytes: &[u8], origin: &str) -> Result<(Mesh, LoadReport)> {
         colors: if colors.len() == n && n > 0 { Some(colors) } else { None },
         extra: Vec::new(),
     };
+    // The draw calls count the triangles `tobj` makes of each face; should it ever make others,
+    // the whole file is one draw call rather than ranges that point at the wrong triangles.
+    if report.draw_calls.last().map(|r| r.end) != Some(triangles.len()) {
+        report.draw_calls = std::iter::once(0..triangles.len()).collect();
+    }
     Ok((Mesh::new(origin, positions, triangles, attributes)?, report))
 }
 
@@ -146,11 +151,19 @@ const OTHER_KEYWORDS: [&str; 32] = [
     "stech",
 ];
 
-/// The outcome of [`check`]: the lines `tobj` should see, and what they leave out.
+/// The outcome of [`check`]: the lines `tobj` should see, what they leave out, and the draw calls.
 struct Checked {
     text: String,
     counts: Counts,
     dropped: Vec<String>,
+    draw_calls: Vec<std::ops::Range<usize>>,
+}
+
+/// Whether an OBJ keyword only describes data (vertices, faces, free-form points), so that faces
+/// on either side of it share their group, material and smoothing group; any other statement
+/// (`o`, `g`, `s`, `usemtl`, …) sets state, and ends a draw call.
+pub(crate) fn keeps_state(keyword: &str) -> bool {
+    matches!(keyword, "v" | "vt" | "vn" | "vp" | "f" | "l" | "p")
 }
 
 /// Checks every `v`, `vt`, `vn` and `f` line, returning them (only them) as new text, or the
@@ -169,6 +182,7 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
 
     let mut seen = Counts::default();
     let mut kept = String::with_capacity(text.len());
+    let (mut draw_calls, mut triangles, mut call_start) = (Vec::new(), 0, 0);
     for (index, line) in text.lines().enumerate() {
         let at = |problem: String| format!("line {}: {problem}", index + 1);
         // `#` starts a comment anywhere on a line; what follows it is not data.
@@ -177,6 +191,10 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
         let Some(keyword) = words.next() else {
             continue;
         };
+        if !keeps_state(keyword) && triangles > call_start {
+            draw_calls.push(call_start..triangles);
+            call_start = triangles;
+        }
         let values: Vec<&str> = words.collect();
         match keyword {
             "v" => {
@@ -202,6 +220,8 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
                     check_corner(corner, &seen, &totals).map_err(at)?;
                 }
                 seen.faces += 1;
+                // `tobj` fans a polygon of n corners into n − 2 triangles.
+                triangles += values.len() - 2;
             }
             "l" => {
                 seen.polylines += 1;
@@ -228,6 +248,9 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
     if seen.faces == 0 {
         return Err(format!("no faces: the file has {} vertices and no `f` lines", seen.positions));
     }
+    if triangles > call_start {
+        draw_calls.push(call_start..triangles);
+    }
     let mut dropped = Vec::new();
     if seen.unknown > 0 {
         dropped.push(format!(
@@ -243,7 +266,7 @@ fn check(text: &str) -> std::result::Result<Checked, String> {
         kept = strip_colors(&kept);
         seen.colored = 0;
     }
-    Ok(Checked { text: kept, counts: seen, dropped })
+    Ok(Checked { text: kept, counts: seen, dropped, draw_calls })
 }
 
 /// `text` (as built by [`check`]) with every `v` line cut to its three coordinates.
@@ -384,4 +407,138 @@ pub fn write(mesh: &Mesh, out: &mut dyn Write) -> io::Result<Vec<String>> {
         writeln!(out)?;
     }
     Ok(dropped)
+}
+
+/// One `f` line of a file, as [`reorder`] moves it.
+struct FaceLine {
+    /// Its line, as in the file (ending included).
+    line: usize,
+    /// The triangles it makes: n − 2 for n corners.
+    triangles: usize,
+    /// The draw call (run of faces between state statements) it belongs to.
+    call: usize,
+    /// How many `v`, `vt` and `vn` lines precede it: what its negative indices count back from.
+    before: [i64; 3],
+}
+
+/// The OBJ `bytes` (a file [`read`] accepts) with its face lines in the order `order` gives: a
+/// permutation of the triangles `read` returns, keeping each draw call's triangles within it
+/// (`order::draw_calls` does). Everything else stays where it is, byte for byte: comments,
+/// `mtllib`, `o`, `g`, `s`, `usemtl`, the vertex lines and their order, line endings. Each face
+/// line moves whole (a polygon stays a polygon, placed where the order put its first triangle)
+/// to a face slot of its own draw call, so every face keeps its object, group, material and
+/// smoothing group. A face with negative (relative) indices that moves is written with the
+/// absolute indices they meant. Returns the bytes and notes for the user.
+pub fn reorder(bytes: &[u8], origin: &str, order: &[u32]) -> Result<(Vec<u8>, Vec<String>)> {
+    let (mesh, _) = read(bytes, origin)?;
+    crate::order::check_permutation(order, mesh.triangle_count())
+        .map_err(|why| Error::input(origin, format!("the triangle order does not fit this file: {why}")))?;
+    let body = bytes.strip_prefix(crate::mesh::BOM).unwrap_or(bytes);
+    let lines: Vec<&[u8]> = body.split_inclusive(|&b| b == b'\n').collect();
+    let mut faces: Vec<FaceLine> = Vec::new();
+    let (mut counts, mut call, mut in_call) = ([0i64; 3], 0, false);
+    for (i, line) in lines.iter().enumerate() {
+        let text = String::from_utf8_lossy(line);
+        let data = text.split_once('#').map_or(&*text, |(data, _)| data);
+        let mut words = data.split_whitespace();
+        let Some(keyword) = words.next() else { continue };
+        match keyword {
+            "v" => counts[0] += 1,
+            "vt" => counts[1] += 1,
+            "vn" => counts[2] += 1,
+            "f" => {
+                faces.push(FaceLine { line: i, triangles: words.count() - 2, call, before: counts });
+                in_call = true;
+            }
+            k if !keeps_state(k) && in_call => {
+                call += 1;
+                in_call = false;
+            }
+            _ => {}
+        }
+    }
+    // Each triangle's face, then the faces in the order of their first triangle.
+    let face_of: Vec<usize> =
+        faces.iter().enumerate().flat_map(|(f, face)| std::iter::repeat_n(f, face.triangles)).collect();
+    if face_of.len() != order.len() {
+        return Err(Error::input(origin, "the faces do not make the triangles the reader found".to_string()));
+    }
+    let mut placed = vec![false; faces.len()];
+    let mut sequence = Vec::with_capacity(faces.len());
+    for &t in order {
+        let f = face_of[t as usize];
+        if !std::mem::replace(&mut placed[f], true) {
+            sequence.push(f);
+        }
+    }
+    let mut out = Vec::with_capacity(bytes.len());
+    out.extend_from_slice(&bytes[..bytes.len() - body.len()]);
+    // Face slot k (the k-th face line of the file) takes the k-th face of the new sequence.
+    let mut k = 0;
+    for (i, line) in lines.iter().enumerate() {
+        if faces.get(k).is_none_or(|slot| slot.line != i) {
+            out.extend_from_slice(line);
+            continue;
+        }
+        let (slot, face) = (&faces[k], &faces[sequence[k]]);
+        k += 1;
+        if face.call != slot.call {
+            return Err(Error::input(origin, "the order moves a face out of its draw call (group, material)"));
+        }
+        // The face's text, with the slot's own line ending: a file's line endings stay put.
+        let content = moved_face(lines[face.line], face.before, face.line != slot.line);
+        out.extend_from_slice(&content[..without_ending(&content)]);
+        out.extend_from_slice(&line[without_ending(line)..]);
+    }
+    let mut notes = Vec::new();
+    let polygons = faces.iter().filter(|f| f.triangles > 1).count();
+    if polygons > 0 {
+        notes.push(format!(
+            "{polygons} polygon(s) (faces of more than 3 corners) kept whole: each is drawn where the order placed its first triangle ({} had been spread apart by the order)",
+            spread(order, &faces, &face_of)
+        ));
+    }
+    Ok((out, notes))
+}
+
+/// The length of `line` without its line ending.
+fn without_ending(line: &[u8]) -> usize {
+    line.len() - line.iter().rev().take_while(|&&b| b == b'\n' || b == b'\r').count()
+}
+
+/// How many polygons of `faces` (with `face_of` each triangle's face) `order` does not draw in one
+/// run of consecutive triangles.
+fn spread(order: &[u32], faces: &[FaceLine], face_of: &[usize]) -> usize {
+    let mut at: Vec<Vec<usize>> = faces.iter().map(|f| Vec::with_capacity(f.triangles)).collect();
+    for (rank, &t) in order.iter().enumerate() {
+        at[face_of[t as usize]].push(rank);
+    }
+    at.iter().filter(|ranks| ranks.len() > 1 && ranks.windows(2).any(|w| w[1] != w[0] + 1)).count()
+}
+
+/// A face line as written at its new place: as it was, unless it moved and counts back from its
+/// old place (negative indices), which are then made absolute.
+fn moved_face(line: &[u8], before: [i64; 3], moved: bool) -> Vec<u8> {
+    let text = String::from_utf8_lossy(line);
+    let (data, comment) = text.split_once('#').map_or((&*text, None), |(d, c)| (d, Some(c)));
+    if !moved || !data.contains('-') {
+        return line.to_vec();
+    }
+    let absolute = |corner: &str| {
+        corner
+            .split('/')
+            .enumerate()
+            .map(|(k, part)| match part.parse::<i64>() {
+                Ok(i) if i < 0 => (before[k.min(2)] + 1 + i).to_string(),
+                _ => part.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join("/")
+    };
+    let corners: Vec<String> = data.split_whitespace().skip(1).map(absolute).collect();
+    let mut out = format!("f {}", corners.join(" "));
+    if let Some(comment) = comment {
+        out.push_str(&format!(" #{comment}"));
+    }
+    out.into_bytes()
 }

@@ -1,5 +1,6 @@
-//! Stanford PLY: reading (ascii, binary little and big endian, via `ply-rs-bw`) and writing
-//! (binary little endian).
+//! Stanford PLY: reading (ascii, binary little and big endian, via `ply-rs-bw`), writing
+//! (binary little endian), and [`reorder`]ing a file's faces in place, which keeps what `read`
+//! drops (face properties, other elements) so that an ordered file is the same asset.
 //!
 //! `ply-rs-bw` parses the header and decodes one element at a time; it returns errors, not
 //! panics, on truncated or malformed payloads (tested in `tests/bad_input.rs`). Driving it one
@@ -10,6 +11,7 @@
 //! header declares (it ignores the rest), and non-finite or out-of-range values.
 
 use std::io::{self, Write};
+use std::ops::Range;
 
 use glam::Vec3;
 use ply_rs_bw::parser::Parser;
@@ -113,6 +115,7 @@ pub fn read(bytes: &[u8], origin: &str) -> Result<(Mesh, LoadReport)> {
         return Err(fail(format!("no faces: element 'face' is empty ({} vertices)", positions.len())));
     }
     let triangles = triangulate(&faces, face_list.position, positions.len()).map_err(fail)?;
+    report.draw_calls = std::iter::once(0..triangles.len()).collect();
     Ok((Mesh::new(origin, positions, triangles, attributes)?, report))
 }
 
@@ -689,4 +692,272 @@ pub fn write(mesh: &Mesh, out: &mut dyn Write) -> io::Result<Vec<String>> {
         out.write_all(&record)?;
     }
     Ok(dropped)
+}
+
+/// One face record of a PLY payload, as byte ranges of the file: `text` is the record itself,
+/// `end` its line ending (`\n`, `\r\n`, or none for the last line of an ASCII file; always empty
+/// in binary). `corners` is its number of vertex indices.
+struct FaceRecord {
+    text: Range<usize>,
+    end: Range<usize>,
+    corners: usize,
+}
+
+/// `bytes` (a PLY file that [`read`] accepts) with its face records in the order `order` gives:
+/// `order` is a permutation of the triangles `read` returns for the same bytes (faces with n > 3
+/// corners are fan-triangulated by `read` into n − 2 consecutive triangles). Every face record is
+/// written whole (all its properties: the index list, and any other face property such as
+/// colours or flags), in the order of the first of its triangles in `order`; the header, the
+/// vertex records, every other element, comments and the encoding (ascii, binary little or big
+/// endian) are kept exactly as they are. Returns the new bytes and, as notes, anything worth
+/// telling the user (how many polygons were kept whole, and of those, how many `order` had
+/// spread apart).
+///
+/// Why not [`write`] the reordered mesh: `order` promises the same asset, only faster to draw,
+/// and [`read`] keeps neither face properties nor other elements. So the file is checked by
+/// `read` first, then walked record by record exactly as `read` walks it (the same header
+/// parser for where the payload starts, one line per ASCII record, what `ply-rs-bw` consumes
+/// for a binary one): the two cannot disagree on where a face is. ASCII line endings stay with
+/// their line position, so a last line without one stays so and the file keeps its length.
+pub fn reorder(bytes: &[u8], origin: &str, order: &[u32]) -> Result<(Vec<u8>, Vec<String>)> {
+    let fail = |problem: String| Error::input(origin, problem);
+    let (mesh, _) = read(bytes, origin)?;
+    crate::order::check_permutation(order, mesh.triangle_count())
+        .map_err(|e| fail(format!("the triangle order does not fit this file: {e}")))?;
+    let faces = face_records(bytes).ok_or_else(|| fail("the face records could not be located".into()))?;
+    // Triangle → face: face f owns the next `corners - 2` triangles, as `triangulate` made them.
+    let face_of: Vec<usize> =
+        faces.iter().enumerate().flat_map(|(f, r)| std::iter::repeat_n(f, r.corners.saturating_sub(2))).collect();
+    let (Some(first), Some(last)) = (faces.first(), faces.last()) else {
+        return Err(fail("no faces".into()));
+    };
+    if face_of.len() != order.len() {
+        return Err(fail(format!("{} triangles in the face records, {} read", face_of.len(), order.len())));
+    }
+
+    let mut out = Vec::with_capacity(bytes.len());
+    out.extend_from_slice(&bytes[..first.text.start]);
+    let mut placed = vec![false; faces.len()];
+    let mut slots = faces.iter();
+    for &t in order {
+        let f = face_of[t as usize];
+        if !std::mem::replace(&mut placed[f], true) {
+            let slot = slots.next().ok_or_else(|| fail("more faces placed than read".into()))?;
+            out.extend_from_slice(&bytes[faces[f].text.clone()]);
+            out.extend_from_slice(&bytes[slot.end.clone()]);
+        }
+    }
+    out.extend_from_slice(&bytes[last.end.end..]);
+
+    // A polygon is drawn whole where its first triangle was placed: say how far that departs
+    // from `order`, which may have spread a polygon's triangles apart.
+    let mut position = vec![0; order.len()];
+    order.iter().enumerate().for_each(|(p, &t)| position[t as usize] = p);
+    let (mut polygons, mut apart, mut next) = (0, 0, 0);
+    for record in &faces {
+        let triangles = &position[next..next + record.corners.saturating_sub(2)];
+        next += triangles.len();
+        if let (Some(lo), Some(hi)) = (triangles.iter().min(), triangles.iter().max())
+            && triangles.len() > 1
+        {
+            polygons += 1;
+            apart += usize::from(hi - lo + 1 != triangles.len());
+        }
+    }
+    let mut notes = Vec::new();
+    if polygons > 0 {
+        let (s, were) = if polygons == 1 { ("", "was") } else { ("s", "were") };
+        notes.push(format!(
+            "{polygons} polygon{s} (faces of more than 3 corners) {were} kept whole: the triangles of each are \
+             drawn together, where the order placed the first ({apart} had been spread apart by the order)"
+        ));
+    }
+    Ok((out, notes))
+}
+
+/// The face records of a PLY file [`read`] accepts, in file order; `None` if the payload does
+/// not walk as `read` walks it (which `read` accepting the file rules out).
+fn face_records(bytes: &[u8]) -> Option<Vec<FaceRecord>> {
+    let body = bytes.strip_prefix(crate::mesh::BOM).unwrap_or(bytes);
+    let parser = Parser::<Row>::new();
+    let mut payload = body;
+    let header = parser.read_header(&mut ply_rs_bw::parser::Reader::new(&mut payload)).ok()?;
+    let face_def = header.elements.get("face")?;
+    let list = face_list_index(face_def, &HeaderText::scan(body)).ok()?.position;
+    let mut faces = Vec::with_capacity(face_def.count.min(payload.len()));
+    for def in header.elements.values() {
+        for _ in 0..def.count {
+            let start = bytes.len() - payload.len();
+            let (row, ending) = next_record(&parser, &header.encoding, def, &mut payload)?;
+            let end = bytes.len() - payload.len();
+            if def.name == "face" {
+                let corners = row.0.get(list).and_then(list_len)?;
+                faces.push(FaceRecord { text: start..end - ending, end: end - ending..end, corners });
+            }
+        }
+        if def.name == "face" {
+            return Some(faces);
+        }
+    }
+    None
+}
+
+/// Decodes the next record of `def` as [`read`] does (an ASCII record is one line), moves
+/// `payload` past it and returns it with the length of its line ending.
+fn next_record(
+    parser: &Parser<Row>,
+    encoding: &Encoding,
+    def: &ElementDef,
+    payload: &mut &[u8],
+) -> Option<(Row, usize)> {
+    match encoding {
+        Encoding::Ascii => {
+            let end = payload.iter().position(|&b| b == b'\n').map_or(payload.len(), |n| n + 1);
+            let (line, rest) = payload.split_at(end);
+            *payload = rest;
+            let ending = [&b"\r\n"[..], b"\n"].iter().find(|e| line.ends_with(e)).map_or(0, |e| e.len());
+            Some((parser.read_ascii_element(std::str::from_utf8(line).ok()?, def).ok()?, ending))
+        }
+        Encoding::BinaryLittleEndian => Some((parser.read_little_endian_element(payload, def).ok()?, 0)),
+        Encoding::BinaryBigEndian => Some((parser.read_big_endian_element(payload, def).ok()?, 0)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The triangles `read` makes of [`square_and_pentagon`]'s faces 0, 1 and 2 (a pentagon).
+    const TRIANGLES: [&[[u32; 3]]; 3] = [&[[0, 1, 2]], &[[0, 2, 3]], &[[4, 5, 6], [4, 6, 7], [4, 7, 8]]];
+
+    /// A PLY with a square (faces 0 and 1, triangles) and a pentagon (face 2), each face with a
+    /// `uchar red` of 10, 20, 30, and an `edge` element; faces written in `faces` order, the face
+    /// element first or last, lines ending in `eol` (the payload too, in ASCII).
+    fn square_and_pentagon(format: &str, faces: [usize; 3], face_first: bool, eol: &str) -> Vec<u8> {
+        let positions = [[0.0f32, 0.0, 0.0], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]].into_iter().chain([
+            [2.0f32, 0.0, 0.0],
+            [3., 0., 0.],
+            [3.5, 1., 0.],
+            [2.5, 1.5, 0.],
+            [1.5, 1., 0.],
+        ]);
+        let corners: [&[i32]; 3] = [&[0, 1, 2], &[0, 2, 3], &[4, 5, 6, 7, 8]];
+        let big = format == "binary_big_endian";
+        let int = |v: i32| if big { v.to_be_bytes() } else { v.to_le_bytes() };
+        let float = |v: f32| if big { v.to_be_bytes() } else { v.to_le_bytes() };
+        let record = |words: Vec<String>, binary: Vec<u8>| match format {
+            "ascii" => (words.join(" ") + eol).into_bytes(),
+            _ => binary,
+        };
+
+        let vertex_header = "element vertex 9\nproperty float x\nproperty float y\nproperty float z\n";
+        let face_header = "element face 3\nproperty list uchar int vertex_indices\nproperty uchar red\n";
+        let edge_header = "element edge 1\nproperty int vertex1\nproperty int vertex2\n";
+        let vertices: Vec<u8> = positions
+            .flat_map(|p| record(p.map(|c| c.to_string()).to_vec(), p.into_iter().flat_map(float).collect()))
+            .collect();
+        let face_records: Vec<u8> = faces
+            .iter()
+            .flat_map(|&f| {
+                let red = 10 * (f as u8 + 1);
+                let mut words = vec![corners[f].len().to_string()];
+                words.extend(corners[f].iter().map(i32::to_string));
+                words.push(red.to_string());
+                let mut binary = vec![corners[f].len() as u8];
+                binary.extend(corners[f].iter().flat_map(|&v| int(v)));
+                binary.push(red);
+                record(words, binary)
+            })
+            .collect();
+        let edges = record(vec!["0".into(), "2".into()], [int(0), int(2)].concat());
+
+        let (elements, payload) = if face_first {
+            ([face_header, vertex_header, edge_header], [face_records, vertices, edges])
+        } else {
+            ([vertex_header, edge_header, face_header], [vertices, edges, face_records])
+        };
+        let header =
+            format!("ply\nformat {format} 1.0\ncomment two faces and a polygon\n{}end_header\n", elements.concat());
+        let mut bytes = header.replace('\n', eol).into_bytes();
+        bytes.extend(payload.concat());
+        bytes
+    }
+
+    /// `order` puts triangle 3 (the pentagon's second) first, then face 1, then face 0.
+    const ORDER: [u32; 5] = [3, 1, 4, 0, 2];
+
+    fn check(original: &[u8], expected: &[u8]) {
+        let (bytes, notes) = reorder(original, "in.ply", &ORDER).unwrap();
+        assert_eq!(bytes.len(), original.len());
+        assert!(bytes == expected, "{:?}\n{:?}", String::from_utf8_lossy(&bytes), String::from_utf8_lossy(expected));
+        let (before, _) = read(original, "in.ply").unwrap();
+        let (after, _) = read(&bytes, "out.ply").unwrap();
+        assert_eq!(after.positions, before.positions);
+        assert_eq!(after.triangles, [TRIANGLES[2], TRIANGLES[1], TRIANGLES[0]].concat());
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].starts_with("1 polygon (") && notes[0].ends_with("(1 had been spread apart by the order)"),
+            "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn faces_move_whole_with_their_properties_in_every_encoding() {
+        for format in ["ascii", "binary_little_endian", "binary_big_endian"] {
+            for face_first in [false, true] {
+                let original = square_and_pentagon(format, [0, 1, 2], face_first, "\n");
+                // Every byte but the face records' is the same; the red values moved with them.
+                check(&original, &square_and_pentagon(format, [2, 1, 0], face_first, "\n"));
+            }
+        }
+    }
+
+    #[test]
+    fn a_byte_order_mark_and_crlf_line_endings_are_kept() {
+        for format in ["ascii", "binary_little_endian"] {
+            let with_bom = |faces| [crate::mesh::BOM, &square_and_pentagon(format, faces, false, "\r\n")].concat();
+            check(&with_bom([0, 1, 2]), &with_bom([2, 1, 0]));
+        }
+        // The last ASCII line without a line ending: the face that moves there goes without one.
+        let unterminated = |faces| {
+            let mut bytes = square_and_pentagon("ascii", faces, false, "\r\n");
+            bytes.truncate(bytes.len() - 2);
+            bytes
+        };
+        check(&unterminated([0, 1, 2]), &unterminated([2, 1, 0]));
+    }
+
+    #[test]
+    fn no_note_without_polygons_and_the_identity_changes_nothing() {
+        let original = square_and_pentagon("ascii", [0, 1, 2], false, "\n");
+        assert_eq!(reorder(&original, "in.ply", &[0, 1, 2, 3, 4]).unwrap().0, original);
+        let triangles_only = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+            property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+            0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        assert_eq!(reorder(triangles_only, "t.ply", &[0]).unwrap(), (triangles_only.to_vec(), vec![]));
+    }
+
+    #[test]
+    fn an_order_that_is_not_a_permutation_is_refused_naming_the_file() {
+        let original = square_and_pentagon("binary_little_endian", [0, 1, 2], false, "\n");
+        for order in [&[0, 1, 2, 3][..], &[0, 1, 2, 3, 3], &[0, 1, 2, 3, 5]] {
+            let error = reorder(&original, "in.ply", order).unwrap_err().to_string();
+            assert!(error.starts_with("in.ply: the triangle order does not fit this file"), "{error}");
+        }
+    }
+
+    #[test]
+    fn broken_files_are_errors_not_panics() {
+        for format in ["ascii", "binary_little_endian", "binary_big_endian"] {
+            let original = square_and_pentagon(format, [0, 1, 2], true, "\n");
+            // (An ASCII file cut just before its final line ending is whole.)
+            for end in 0..original.len() - usize::from(format == "ascii") {
+                assert!(reorder(&original[..end], "in.ply", &ORDER).is_err(), "{format} cut at {end}");
+            }
+        }
+        let no_faces = b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+            property float z\nend_header\n0 0 0\n";
+        let error = reorder(no_faces, "v.ply", &[]).unwrap_err().to_string();
+        assert!(error.starts_with("v.ply: no faces"), "{error}");
+    }
 }

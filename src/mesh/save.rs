@@ -51,6 +51,15 @@ pub fn save(mesh: &Mesh, path: &Path) -> Result<SaveReport> {
     Ok(SaveReport { dropped })
 }
 
+/// `mesh` encoded in the format `path` names, in memory, and what the format could not hold: for
+/// a caller that must know what would be lost before it writes anything (`order --strict`).
+pub fn encode(mesh: &Mesh, path: &Path) -> Result<(Vec<u8>, Vec<String>)> {
+    let write = writer(path)?;
+    let mut bytes = Vec::new();
+    let dropped = write(mesh, &mut bytes).map_err(|e| Error::output(path, e))?;
+    Ok((bytes, dropped))
+}
+
 type Writer = fn(&Mesh, &mut dyn Write) -> std::io::Result<Vec<String>>;
 
 fn writer(path: &Path) -> Result<Writer> {

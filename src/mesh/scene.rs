@@ -17,6 +17,11 @@ pub struct Scene {
     pub topology: Topology,
     /// The positions drawn: the mesh itself (one frame), or an animation's keyframes.
     pub frames: Frames,
+    /// The file's draw calls, as ranges of the mesh's triangles ([`LoadReport::draw_calls`]):
+    /// what an engine draws separately. Empty: the mesh is one draw call.
+    ///
+    /// [`LoadReport::draw_calls`]: crate::mesh::load::LoadReport::draw_calls
+    pub draw_calls: Vec<std::ops::Range<usize>>,
 }
 
 impl Scene {
@@ -29,7 +34,7 @@ impl Scene {
     /// `mesh` (the rest pose) drawn in `frames`.
     pub fn animated(mesh: Mesh, frames: Frames) -> Scene {
         let topology = Topology::new(&mesh);
-        Scene { mesh, topology, frames }
+        Scene { mesh, topology, frames, draw_calls: Vec::new() }
     }
 
     /// The mesh as a progressive mesh at each of `fractions` of its triangles (each in (0, 1];
@@ -49,7 +54,8 @@ impl Scene {
         let target = (smallest * self.mesh.triangle_count() as f64).round() as usize;
         let history = History::build(&self.mesh, &self.topology, target);
         let frames = Frames::progressive(&self.mesh, history, &fractions, update);
-        Ok(Scene { frames, ..self })
+        // A level's triangles are not the file's: its draw calls no longer apply.
+        Ok(Scene { frames, draw_calls: Vec::new(), ..self })
     }
 
     /// The same levels with their sequence kept by `update` instead (no effect on other scenes).

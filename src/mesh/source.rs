@@ -79,6 +79,10 @@ impl Source {
                 let (mesh, frames) = animation.open(data)?;
                 Ok(Scene::animated(mesh, frames))
             }
+            Source::File(path) => {
+                let (mesh, draw_calls) = load::load_file_with_draw_calls(&locate_file(path, data)?)?;
+                Ok(Scene { draw_calls, ..Scene::still(mesh) })
+            }
             _ => Ok(Scene::still(self.mesh(data, seed)?)),
         }
     }
@@ -90,6 +94,15 @@ impl Source {
             Source::File(path) => load::load_file(&locate_file(path, data)?),
             Source::Simplified { base, target } => simplify::simplify(&base.mesh(data, seed)?, *target),
             Source::Animation(animation) => Ok(animation.open(data)?.0),
+        }
+    }
+
+    /// The file a file source names, found as [`Source::open`] finds it; `None` for any other
+    /// source (procedural, simplified, animated).
+    pub fn file(&self, data: Option<&Path>) -> Option<Result<PathBuf>> {
+        match self {
+            Source::File(path) => Some(locate_file(path, data)),
+            _ => None,
         }
     }
 

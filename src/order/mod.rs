@@ -103,6 +103,8 @@ macro_rules! registry {
     };
 }
 
+pub mod draw_calls;
+
 registry![
     input,
     random,

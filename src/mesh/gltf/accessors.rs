@@ -225,3 +225,20 @@ pub(super) fn read_indices(
     }
     Ok(indices)
 }
+
+/// Where each element of `accessor` is stored: its buffer, each element's first byte in that
+/// buffer, and the element size. What rewriting an accessor in place needs; a sparse accessor,
+/// or one without a buffer view, is refused (its elements are not all stored in one place).
+pub(super) fn element_offsets(
+    accessor: &Accessor<'_>,
+    buffers: &[Vec<u8>],
+) -> std::result::Result<(usize, Vec<usize>, usize), String> {
+    let what = format!("accessor {}", accessor.index());
+    let (Some(view), None) = (accessor.view(), accessor.sparse()) else {
+        return Err(format!("{what} is sparse: its elements are not stored in one place"));
+    };
+    let element = accessor.size();
+    let l = layout(&view, accessor.offset(), accessor.count(), element, view.stride(), buffers, &what)?;
+    let first = view.offset() + l.start;
+    Ok((view.buffer().index(), (0..accessor.count()).map(|i| first + i * l.stride).collect(), element))
+}

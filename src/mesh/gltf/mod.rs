@@ -16,9 +16,11 @@ mod accessors;
 pub mod animation;
 mod document;
 mod primitive;
+mod rewrite;
 mod scene;
 mod write;
 
+pub use rewrite::{Rewritten, contents, rewrite};
 pub use write::{write, write_levels};
 
 use std::collections::HashMap;

@@ -229,6 +229,7 @@ pub(super) fn merge(parts: Vec<Part>, report: &mut LoadReport) -> (Vec<Vec3>, Ve
         .collect();
     for part in parts {
         let base = positions.len() as u32;
+        report.draw_calls.push(triangles.len()..triangles.len() + part.triangles.len());
         positions.extend(part.positions);
         triangles.extend(part.triangles.iter().map(|t| t.map(|v| v + base)));
         if let (Some(all), Some(mine)) = (normals.as_mut(), part.normals) {
