@@ -138,6 +138,9 @@ fn order_writes_every_format_with_attributes_and_winding_kept() {
             let o = triorder(&args);
             assert!(o.status.success(), "{}", stderr(&o));
             assert!(stdout(&o).contains("ACMR/ATVR fifo:16: "), "{}", stdout(&o));
+            if ext == "glb" {
+                common::assert_valid_gltf(&out);
+            }
             let written = load::load_file(&out).unwrap();
             assert_eq!(written.triangle_count(), input.triangle_count());
             assert!(written.attributes.uvs.is_some(), "{ext}");

@@ -47,6 +47,9 @@ fn round_trip(mesh: &Mesh, file_name: &str, dropped: &[&str]) -> Mesh {
     for (entry, expected) in report.dropped.iter().zip(dropped) {
         assert!(entry.contains(expected), "{file_name}: {entry:?} should mention {expected:?}");
     }
+    if file_name.ends_with(".glb") {
+        common::assert_valid_gltf(&path);
+    }
     let loaded = load_file(&path).unwrap();
     assert_eq!(loaded.name, path.display().to_string());
     let listing: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();

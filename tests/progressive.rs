@@ -176,6 +176,7 @@ fn order_writes_every_level() {
     let glb = dir.path().join("spot.glb");
     let o = order(&glb);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    common::assert_valid_gltf(&glb);
     let (document, buffers, _) = gltf::import(&glb).unwrap();
     assert_eq!(document.default_scene().map(|s| s.index()), Some(0), "the full level is the default scene");
     let written: Vec<Vec<[u32; 3]>> = document

@@ -115,14 +115,19 @@ pub fn write(
             if remap {
                 mesh = mesh.remap_vertices_first_use();
             }
-            let (bytes, dropped) = save::encode(&mesh, output)?;
+            let source = input.unwrap_or(Path::new(&scene.mesh.name));
             let mut lost = match (input, in_kind) {
                 (Some(input), Some(kind)) => held_beyond_a_mesh(input, kind, scene)?,
                 _ => Vec::new(),
             };
-            lost.extend(dropped);
-            refuse_or_warn(input.unwrap_or(Path::new(&scene.mesh.name)), output, &lost, strict)?;
-            triorder::atomic::write_with(output, |out| out.write_all(&bytes))?;
+            if strict {
+                lost.extend(save::would_drop(&mesh, output)?);
+                refuse_or_warn(source, output, &lost, true)?;
+            }
+            // Streamed to its temporary: a large mesh is never held twice in memory.
+            let saved = save::save(&mesh, output)?;
+            lost.extend(saved.dropped);
+            refuse_or_warn(source, output, &lost, false)?;
             Ok(Written { notes: Vec::new(), seconds })
         }
     }

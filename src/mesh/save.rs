@@ -51,13 +51,11 @@ pub fn save(mesh: &Mesh, path: &Path) -> Result<SaveReport> {
     Ok(SaveReport { dropped })
 }
 
-/// `mesh` encoded in the format `path` names, in memory, and what the format could not hold: for
-/// a caller that must know what would be lost before it writes anything (`order --strict`).
-pub fn encode(mesh: &Mesh, path: &Path) -> Result<(Vec<u8>, Vec<String>)> {
+/// What [`save`] would leave out of `mesh` in the format `path` names, found by encoding it into
+/// nothing: for a caller that must know before it writes anything (`order --strict`).
+pub fn would_drop(mesh: &Mesh, path: &Path) -> Result<Vec<String>> {
     let write = writer(path)?;
-    let mut bytes = Vec::new();
-    let dropped = write(mesh, &mut bytes).map_err(|e| Error::output(path, e))?;
-    Ok((bytes, dropped))
+    write(mesh, &mut std::io::sink()).map_err(|e| Error::output(path, e))
 }
 
 type Writer = fn(&Mesh, &mut dyn Write) -> std::io::Result<Vec<String>>;

@@ -245,6 +245,7 @@ impl AnimationSource {
             match key {
                 "clip" if value == "all" => parsed.selection.clip = None,
                 "clip" if !value.is_empty() => parsed.selection.clip = Some(value.to_string()),
+                "clip" => return Some(Err(bad("`clip=` names no clip (write clip=all for every clip)".into()))),
                 "frames" => match value.parse::<usize>().map_err(|_| FRAMES.to_string()).and_then(check_frames) {
                     Ok(n) => parsed.selection.frames = Some(n),
                     Err(why) => return Some(Err(bad(format!("frames `{value}` {why}")))),

@@ -116,3 +116,30 @@ pub fn rejected(path: &std::path::Path, phrases: &[&str]) -> String {
     }
     message
 }
+
+/// The Khronos glTF validator's report on `path` (`scripts/validate-gltf.cjs`: errors, warnings,
+/// and the count of each error and warning code), or `None` where the validator is not installed:
+/// said on stdout, and a failure when `TRIORDER_REQUIRE_VALIDATOR` is set (CI sets it).
+#[allow(dead_code)]
+pub fn gltf_validator(path: &std::path::Path) -> Option<serde_json::Value> {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/validate-gltf.cjs");
+    let why = match std::process::Command::new("node").arg(&script).arg(path).output() {
+        Ok(out) if out.status.success() => return Some(serde_json::from_slice(&out.stdout).unwrap()),
+        Ok(out) => String::from_utf8_lossy(&out.stderr).into_owned(),
+        Err(e) => format!("node: {e}"),
+    };
+    assert!(
+        std::env::var_os("TRIORDER_REQUIRE_VALIDATOR").is_none(),
+        "the glTF validator is required (TRIORDER_REQUIRE_VALIDATOR) but did not run: {why}"
+    );
+    println!("skipped the glTF validator on {}: {why}", path.display());
+    None
+}
+
+/// The validator finds no error and no warning in `path` (where it is installed).
+#[allow(dead_code)]
+pub fn assert_valid_gltf(path: &std::path::Path) {
+    if let Some(report) = gltf_validator(path) {
+        assert_eq!((report["errors"].as_u64(), report["warnings"].as_u64()), (Some(0), Some(0)), "{report}");
+    }
+}

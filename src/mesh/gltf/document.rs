@@ -154,6 +154,8 @@ fn resolve(uri: &str, base: Option<&Path>) -> std::result::Result<PathBuf, Strin
     let Some(base) = base else {
         return Err("names an external file, but the model has no folder to read it from".into());
     };
+    // A model named without a folder (`model.gltf`) lives in the current one.
+    let base = if base.as_os_str().is_empty() { Path::new(".") } else { base };
     let joined = base.join(&path);
     if allowed {
         return Ok(joined);

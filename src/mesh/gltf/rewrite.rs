@@ -231,9 +231,11 @@ fn assemble(
     let stem = out.file_stem().map_or("out".to_string(), |s| s.to_string_lossy().into_owned());
     let mut json: Option<serde_json::Value> = None;
     let mut edit = |path: &[&str], index: usize, value: String| -> std::result::Result<(), String> {
+        // The file's own JSON, not the `gltf` crate's model of it, which drops what it does not
+        // know (extensions, extras of some objects) and adds defaults.
         let root = match &mut json {
             Some(root) => root,
-            None => json.insert(serde_json::to_value(document.as_json()).map_err(|e| e.to_string())?),
+            None => json.insert(serde_json::from_slice(json_text(bytes, binary)).map_err(|e| e.to_string())?),
         };
         let slot = root.get_mut(path[0]).and_then(|a| a.get_mut(index)).and_then(|o| o.as_object_mut());
         slot.ok_or("the JSON does not hold what it declared")?.insert(path[1].to_string(), value.into());
@@ -279,6 +281,16 @@ fn assemble(
         (true, json) => glb(bytes, json, bin)?,
     };
     Ok((main, beside))
+}
+
+/// The JSON text of a glTF file: a GLB's first chunk, or the file itself.
+fn json_text(bytes: &[u8], binary: bool) -> &[u8] {
+    let bytes = bytes.strip_prefix(crate::mesh::BOM).unwrap_or(bytes);
+    if !binary && !bytes.starts_with(b"glTF") {
+        return bytes;
+    }
+    let length = bytes.get(12..16).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    bytes.get(20..20 + length).unwrap_or_default()
 }
 
 /// The GLB `bytes` with its BIN chunk's buffer replaced by `bin`, and its JSON chunk by `json`
