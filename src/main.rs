@@ -66,6 +66,12 @@ struct Measure {
     /// Timed frames per view and shader for --render (their median is reported).
     #[arg(long, default_value_t = 30, value_name = "N")]
     render_frames: usize,
+    /// Also measure, over --views, how wrong each order is when the mesh is drawn translucent
+    /// (alpha 0.5, blended in draw order) against the exact depth-sorted blend: the share of
+    /// covered pixels visibly wrong, the colour RMSE and the wrongly blended fragment pairs per
+    /// pixel (CPU reference rasterizer).
+    #[arg(long)]
+    translucency: bool,
     /// Raster backend for overdraw: cpu (the reference rasterizer) or gpu (Vulkan through wgpu;
     /// Mesa's lavapipe will do where there is no GPU).
     #[arg(long, default_value = "cpu", value_name = "cpu|gpu")]

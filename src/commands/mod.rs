@@ -42,6 +42,9 @@ impl Measuring {
         if !render.is_empty() && views.is_none() {
             return Err(Error::usage("--render times every view of --views: give a view set"));
         }
+        if m.translucency && views.is_none() {
+            return Err(Error::usage("--translucency blends every view of --views: give a view set"));
+        }
         if !(1..=MAX_FRAMES).contains(&m.render_frames) {
             return Err(Error::usage(format!("--render-frames {} is outside 1..={MAX_FRAMES}", m.render_frames)));
         }
@@ -54,6 +57,7 @@ impl Measuring {
             render,
             render_frames: m.render_frames,
             per_draw_call: false,
+            translucency: m.translucency,
         };
         Ok(Measuring { options, raster })
     }

@@ -39,6 +39,8 @@
 //! render = ["pixel", "vertex"]     # optional, with views: time rendering on the GPU from every
 //!                                  # view with a pixel-bound and/or a vertex-bound shader
 //! render_frames = 30               # optional: timed frames per view and shader (default 30)
+//! translucency = true              # optional, with views: also measure how wrong each order
+//!                                  # is blended as a translucent mesh (measure/translucency.rs)
 //! levels = [1.0, 0.5, 0.25]        # optional: measure each static model as a progressive mesh
 //!                                  # at these fractions of its triangles (rows name `level`)
 //! updates = ["simple", "smart"]    # optional, with levels: how each method's sequence follows
@@ -131,6 +133,8 @@ pub struct Spec {
     pub backend: String,
     /// Shaders to time rendering with on the GPU, from every view (`render = ["pixel", "vertex"]`).
     pub render: Vec<Shading>,
+    /// Also measure the translucency error over the view set (`translucency = true`).
+    pub translucency: bool,
     /// Canonical method specs (every parameter written out), grids expanded, duplicates
     /// removed, in the order the spec lists them.
     pub methods: Vec<String>,
@@ -202,6 +206,7 @@ impl Spec {
             render_frames: work.render_frames,
             // Specs measure whole meshes, as the papers do.
             per_draw_call: false,
+            translucency: self.translucency,
         }
     }
 
@@ -271,6 +276,8 @@ struct RawSpec {
     levels: Option<Vec<f64>>,
     #[serde(default)]
     updates: Vec<String>,
+    #[serde(default)]
+    translucency: bool,
     figure: RawFigure,
     quick: Option<RawQuick>,
 }
@@ -389,11 +396,15 @@ impl RawSpec {
         if !render.is_empty() && (full.views.is_none() || quick.as_ref().is_some_and(|q| q.views.is_none())) {
             return Err(err("render times every view of `views`: set views".into()));
         }
+        if self.translucency && (full.views.is_none() || quick.as_ref().is_some_and(|q| q.views.is_none())) {
+            return Err(err("translucency blends every view of `views`: set views".into()));
+        }
         let options = MeasureOptions {
             caches: full.caches.clone(),
             gpu_vertices: full.gpu_vertices,
             views: full.views,
             render: render.clone(),
+            translucency: self.translucency,
             ..Default::default()
         };
         let writes = Writes {
@@ -431,6 +442,7 @@ impl RawSpec {
             seed: self.seed,
             backend,
             render,
+            translucency: self.translucency,
             methods,
             updates,
             full,

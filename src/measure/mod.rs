@@ -44,7 +44,7 @@ macro_rules! registry {
     };
 }
 
-registry![cache, gpu_vertices, overdraw, render];
+registry![cache, gpu_vertices, overdraw, render, translucency];
 
 /// What the ordering itself reports, beside the metrics: every row of a run also carries the
 /// ordering's time, and runs that compare methods with several buffers say how many each needs.
@@ -121,6 +121,9 @@ pub struct MeasureOptions {
     /// Order each of the scene's draw calls on its own and measure them in sequence, as an
     /// engine draws an asset ([`order::draw_calls`]); otherwise the whole mesh, as the papers do.
     pub per_draw_call: bool,
+    /// Also measure how wrong each order is for translucent rendering over the view set
+    /// ([`translucency`]).
+    pub translucency: bool,
 }
 
 impl MeasureOptions {

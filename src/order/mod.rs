@@ -104,6 +104,7 @@ macro_rules! registry {
 }
 
 pub mod draw_calls;
+pub mod translucent;
 
 registry![
     input,
@@ -125,6 +126,8 @@ registry![
     front_to_back,
     tipsify_per_frame,
     hs17,
+    translucent::dist_angle,
+    translucent::per_view,
 ];
 
 /// A method spec resolved against the registry: ready to run, with its canonical name.

@@ -1,0 +1,7 @@
+//! Static sorts for translucent meshes (seed 003, Chad Austin, "Update on Sorting Translucent
+//! Triangles", 2014): one index order that an engine draws back to front, with blending and no
+//! depth writes, from every view. Measured by the translucency metric
+//! (`measure::translucency`), which the blog's author judged by eye.
+
+pub mod dist_angle;
+pub mod per_view;
