@@ -82,3 +82,25 @@ x = "model"
     let err = triorder::experiment::run(&spec, &opts).unwrap_err().to_string();
     assert!(err.contains("translucency") && err.contains("views"), "{err}");
 }
+
+#[test]
+fn every_static_sort_puts_a_reversed_stack_back_to_front() {
+    // The layers of `layers:5` listed top first (nearest the +z view first): every translucent
+    // sort must draw them bottom first, exactly.
+    let layers = Source::parse("layers:5").unwrap().mesh(None, 0).unwrap();
+    let mut triangles = layers.triangles.clone();
+    triangles.reverse();
+    let mesh = triorder::mesh::Mesh { triangles, ..layers };
+    let scene = triorder::mesh::Scene::still(mesh);
+    let raster = measure::backend("cpu").unwrap();
+    let o = options("axis6", 64);
+    let input = measure::evaluate(&scene, &order::resolve("input", 0).unwrap(), &o, raster.as_ref()).unwrap();
+    let wrong = |e: &measure::Evaluation| {
+        e.values().find(|v| v.metric == "translucency_pairs" && v.is_summary()).unwrap().value
+    };
+    assert_eq!(wrong(&input), 10.0, "all 5·4/2 pairs inverted as listed");
+    for method in ["translucent-topo", "translucent-coverage", "translucent-dist-angle", "translucent-peeling"] {
+        let e = measure::evaluate(&scene, &order::resolve(method, 0).unwrap(), &o, raster.as_ref()).unwrap();
+        assert_eq!(wrong(&e), 0.0, "{method}");
+    }
+}

@@ -126,7 +126,10 @@ registry![
     front_to_back,
     tipsify_per_frame,
     hs17,
+    translucent::topo,
+    translucent::coverage,
     translucent::dist_angle,
+    translucent::peeling,
     translucent::per_view,
 ];
 

@@ -3,5 +3,10 @@
 //! depth writes, from every view. Measured by the translucency metric
 //! (`measure::translucency`), which the blog's author judged by eye.
 
+pub mod coverage;
 pub mod dist_angle;
+pub mod pairs;
+mod params;
+pub mod peeling;
 pub mod per_view;
+pub mod topo;
