@@ -223,6 +223,16 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
             &mut || drop(black_box(tipsify(black_box(triangles), &vertex_triangles(mesh), 16))),
         ],
     );
+    // Not a peer but the speed to match (issue 18): the O(n log n) translucent sort against
+    // meshoptimizer's linear FIFO optimizer.
+    let dist_angle = order::resolve("translucent-dist-angle", 0).expect("a registered method");
+    let dist_acmr = (ours_acmr("translucent-dist-angle"), fifo_acmr.1);
+    let [dist_theirs, dist_ours] = median_interleaved(
+        reps,
+        [&mut || drop(black_box(meshopt::optimize_vertex_cache_fifo(black_box(&indices), n, 16))), &mut || {
+            drop(black_box(dist_angle.ordering.order(black_box(scene))))
+        }],
+    );
     let vcache_acmr = (ours_acmr("forsyth:cache=32"), theirs_acmr(meshopt::optimize_vertex_cache(&indices, n)));
     let [vcache_theirs, forsyth_ours, forsyth_with_adjacency] = median_interleaved(
         reps,
@@ -250,6 +260,7 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
     vec![
         row("tipsify:cache=16 vs optimizeVertexCacheFifo(16)", ours, fifo_theirs, fifo_acmr),
         row("  the same, + adjacency", with_adjacency, fifo_theirs, fifo_acmr),
+        row("translucent-dist-angle vs optimizeVertexCacheFifo", dist_ours, dist_theirs, dist_acmr),
         row("forsyth:cache=32 vs optimizeVertexCache", forsyth_ours, vcache_theirs, vcache_acmr),
         row("  the same, + adjacency", forsyth_with_adjacency, vcache_theirs, vcache_acmr),
         row("sander07 vs optimizeVertexCache+Overdraw(1.05)", sander_ours, overdraw_theirs, overdraw_acmr),

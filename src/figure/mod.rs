@@ -101,7 +101,8 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         }
         FigureKind::Table => {
             panels = table.select(figure)?;
-            Box::new(table::Tables(bar::Bars::new(&panels)))
+            let best_per_column = figure.series == "metric";
+            Box::new(table::Tables { bars: bar::Bars::new(&panels), best_per_column })
         }
         FigureKind::Sequence
         | FigureKind::Corners

@@ -1,7 +1,9 @@
 //! Tables drawn as SVG: one row per x value (e.g. per model), one column per series (e.g. per
 //! method), the metric in each cell — for the papers' tables (Bogomjakov & Gotsman 2002 Tables 1
-//! and 2), where the reader compares numbers, not shapes. The best value of each row is bold
-//! when the metric is one where lower is better (all of ours are: misses, overdraw, time).
+//! and 2), where the reader compares numbers, not shapes. The best value is bold, lower being
+//! better for all of ours (misses, overdraw, blending errors, time): the best of each row, or of
+//! each column when the columns are different metrics (`series = "metric"`), which only compare
+//! within themselves.
 
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -19,12 +21,16 @@ const FIRST_COL_W: i32 = 280;
 const COL_W: i32 = 124;
 
 /// The same values as a bar chart holds (panel × series × category), drawn as text.
-pub struct Tables(pub Bars);
+pub struct Tables {
+    pub bars: Bars,
+    /// The columns (series) are different metrics: the best is marked per column, not per row.
+    pub best_per_column: bool,
+}
 
 impl Tables {
     /// Each column's heading lines (see [`heading`]) and the headings' height.
     fn headings(&self) -> (Vec<Vec<String>>, i32) {
-        let headings: Vec<Vec<String>> = self.0.series.iter().map(|name| heading(name, &self.0.series)).collect();
+        let headings: Vec<Vec<String>> = self.bars.series.iter().map(|name| heading(name, &self.bars.series)).collect();
         let lines = headings.iter().map(Vec::len).max().unwrap_or(1).max(2);
         (headings, HEAD_BASE_H + LINE_H * lines as i32)
     }
@@ -33,14 +39,14 @@ impl Tables {
 impl Kind for Tables {
     /// The size that fits the table.
     fn panel_size(&self) -> Option<(usize, usize)> {
-        let bars = &self.0;
+        let bars = &self.bars;
         let w = FIRST_COL_W + COL_W * bars.series.len() as i32 + 20;
         let h = self.headings().1 + ROW_H * bars.categories.len() as i32 + 40;
         Some((w.max(400) as usize, h as usize))
     }
 
     fn extent(&self, _: Option<usize>) -> Extent {
-        Extent { x: XAxis::Categories(self.0.categories.clone()), y: (0.0, 1.0), from_zero: true }
+        Extent { x: XAxis::Categories(self.bars.categories.clone()), y: (0.0, 1.0), from_zero: true }
     }
 
     fn swatch(&self) -> Swatch {
@@ -52,7 +58,7 @@ impl Kind for Tables {
     }
 
     fn draw(&self, index: usize, area: &Area, title: &str, _frame: &Frame, colors: &Colors) -> DrawResult {
-        let bars = &self.0;
+        let bars = &self.bars;
         let values = &bars.values[index];
         let mut y = 8;
         if !title.is_empty() {
@@ -92,10 +98,16 @@ impl Kind for Tables {
             }
             area.draw_text(&truncate(category, 42), &label, (10, mid))?;
             let row: Vec<Option<f64>> = values.iter().map(|s| s[i]).collect();
-            let best = row.iter().flatten().copied().fold(f64::INFINITY, f64::min);
+            let lowest = |cells: &mut dyn Iterator<Item = f64>| cells.fold(f64::INFINITY, f64::min);
+            let best_in_row = lowest(&mut row.iter().flatten().copied());
             for (j, value) in row.iter().enumerate() {
                 let Some(v) = value else { continue };
-                let style = if *v == best && bars.series.len() > 1 { &bold } else { &plain };
+                let best = if self.best_per_column {
+                    *v == lowest(&mut values[j].iter().flatten().copied()) && bars.categories.len() > 1
+                } else {
+                    *v == best_in_row && bars.series.len() > 1
+                };
+                let style = if best { &bold } else { &plain };
                 area.draw_text(&axes::number(*v), style, (FIRST_COL_W + COL_W * (j as i32 + 1) - 6, mid))?;
             }
         }

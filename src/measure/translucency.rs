@@ -127,9 +127,9 @@ pub static METRIC: Translucency = Translucency;
 const NEEDS: &str = "`views` and `translucency`";
 
 static NAMES: &[Name] = &[
-    Name { name: "translucency_wrong_pixels", label: "share of covered pixels blended visibly wrong", needs: NEEDS },
-    Name { name: "translucency_rmse", label: "colour RMSE against the depth-sorted blend", needs: NEEDS },
-    Name { name: "translucency_pairs", label: "fragment pairs blended nearer first, per pixel", needs: NEEDS },
+    Name { name: "translucency_wrong_pixels", label: "wrong-pixel share", needs: NEEDS },
+    Name { name: "translucency_rmse", label: "blend colour RMSE", needs: NEEDS },
+    Name { name: "translucency_pairs", label: "inverted pairs/px", needs: NEEDS },
     Name { name: "translucency_wrong_pixels_view", label: "share of pixels blended visibly wrong, per view", needs: NEEDS },
     Name { name: "translucency_rmse_view", label: "colour RMSE, per view", needs: NEEDS },
     Name { name: "translucency_pairs_view", label: "wrongly blended pairs per pixel, per view", needs: NEEDS },
