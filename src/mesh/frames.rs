@@ -41,14 +41,19 @@ pub struct Framing {
 }
 
 impl Framing {
+    /// The centre of the frame of `positions`: the middle of their bounding box, in f64.
+    pub fn center_of(positions: &[Vec3]) -> DVec3 {
+        let (lo, hi) = positions
+            .iter()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        if positions.is_empty() { DVec3::ZERO } else { (lo.as_dvec3() + hi.as_dvec3()) * 0.5 }
+    }
+
     /// The unit frame itself: positions already centred and of radius 1 map to themselves.
     pub const UNIT: Framing = Framing { center: DVec3::ZERO, radius: 1.0 };
 
     pub fn of(positions: &[Vec3]) -> Framing {
-        let (lo, hi) = positions
-            .iter()
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let center = if positions.is_empty() { DVec3::ZERO } else { (lo.as_dvec3() + hi.as_dvec3()) * 0.5 };
+        let center = Framing::center_of(positions);
         let radius = positions.iter().map(|p| p.as_dvec3().distance(center)).fold(0.0f64, f64::max);
         // A single point or a degenerate mesh still needs a non-empty view volume.
         Framing { center, radius: if radius > 0.0 { radius } else { 1.0 } }

@@ -7,8 +7,11 @@
 //! faces the centre or lies inward of it (a negative or small product: the inside of a cup, the
 //! far wall of a fold) is drawn before the outward-facing surface that covers it. Its errors come
 //! "across entire slabs" rather than per triangle, which the translucency metric's error images
-//! show. O(n log n). The centre is the bounding sphere's ([`Framing`]); the products are taken in
-//! f64 in the unit frame, so a moved or scaled copy sorts the same; ties keep the input order.
+//! show. O(n log n). The centre is the middle of the bounding box, as the unit frame's
+//! ([`Framing`]); the products are taken in f64 from it, so a moved or scaled copy sorts the same;
+//! ties keep the input order.
+
+use glam::Vec3;
 
 use super::super::{Cost, Method, Order, Ordering, Orders, Params};
 use crate::error::Result;
@@ -34,19 +37,72 @@ struct DistAngle;
 impl Ordering for DistAngle {
     fn order(&self, scene: &Scene) -> Result<Orders> {
         let mesh = &scene.mesh;
-        let framing = Framing::of(&mesh.positions);
-        let unit: Vec<_> = mesh.positions.iter().map(|&p| framing.to_unit64(p)).collect();
-        let key: Vec<f64> = mesh
+        let center = Framing::center_of(&mesh.positions);
+        // Positions from the centre: exact in f64 (f32 values and a midpoint of two), then
+        // rounded to f32, so shifting the mesh or scaling it by a power of two changes no key's
+        // order; the products are taken in f32 from there.
+        let from_center: Vec<Vec3> = mesh.positions.iter().map(|p| (p.as_dvec3() - center).as_vec3()).collect();
+        let keys: Vec<u32> = mesh
             .triangles
             .iter()
             .map(|t| {
-                let [a, b, c] = t.map(|v| unit[v as usize]);
-                let normal = (b - a).cross(c - a).normalize_or_zero();
-                normal.dot((a + b + c) / 3.0)
+                let [a, b, c] = t.map(|v| from_center[v as usize]);
+                let normal = (b - a).cross(c - a);
+                let length = normal.length();
+                sortable(if length > 0.0 { normal.dot(a + b + c) / (3.0 * length) } else { 0.0 })
             })
             .collect();
-        let mut order: Order = (0..mesh.triangle_count() as u32).collect();
-        order.sort_by(|&x, &y| key[x as usize].total_cmp(&key[y as usize]));
-        Ok(Orders::from(order))
+        Ok(Orders::from(radix_order(&keys)))
+    }
+}
+
+/// `x`'s bits, reordered so that unsigned comparison orders them as the numbers are ordered.
+fn sortable(x: f32) -> u32 {
+    let bits = x.to_bits();
+    if bits >> 31 == 1 { !bits } else { bits | 0x8000_0000 }
+}
+
+/// The ids `0..keys.len()` sorted by key, ties in id order: a least-significant-digit radix sort
+/// of (key, id) words, three passes of 11 bits with the three histograms counted in one sweep
+/// (linear where a comparison sort is not, and faster at every size here).
+fn radix_order(keys: &[u32]) -> Order {
+    const BITS: u32 = 11;
+    const BUCKETS: usize = 1 << BITS;
+    let mut words: Vec<u64> = keys.iter().enumerate().map(|(id, &k)| u64::from(k) << 32 | id as u64).collect();
+    let mut scratch = vec![0u64; words.len()];
+    let digit = |w: u64, pass: u32| ((w >> (32 + BITS * pass)) as usize) & (BUCKETS - 1);
+    let mut counts = vec![[0usize; BUCKETS]; 3];
+    for &w in &words {
+        for (pass, count) in counts.iter_mut().enumerate() {
+            count[digit(w, pass as u32)] += 1;
+        }
+    }
+    for (pass, count) in counts.iter_mut().enumerate() {
+        let mut start = 0;
+        for slot in count.iter_mut() {
+            (*slot, start) = (start, start + *slot);
+        }
+        for &w in &words {
+            let d = digit(w, pass as u32);
+            scratch[count[d]] = w;
+            count[d] += 1;
+        }
+        std::mem::swap(&mut words, &mut scratch);
+    }
+    words.into_iter().map(|w| w as u32).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radix_order_sorts_by_key_and_keeps_ties_in_order() {
+        let values = [0.5f32, -2.0, 0.5, 1e-30, -0.0, 0.0, f32::MAX, -1e-30];
+        let keys: Vec<u32> = values.iter().map(|&v| sortable(v)).collect();
+        let order = radix_order(&keys);
+        let mut expected: Vec<u32> = (0..values.len() as u32).collect();
+        expected.sort_by(|&a, &b| values[a as usize].total_cmp(&values[b as usize]));
+        assert_eq!(order, expected);
     }
 }
