@@ -462,7 +462,7 @@ fn drawings_show_the_saved_orders_and_refuse_stale_ones() {
     run(&path, &quick(root.path())).unwrap();
     let orders = root.path().join("results/quick/corners.orders.csv");
     let (header, rows) = read_csv(&orders);
-    assert_eq!(header, ["model", "method", "order", "clusters", "corners", "overdraw", "level", "update"]);
+    assert_eq!(header, triorder::results::ORDER_COLUMNS);
     assert!(rows.iter().all(|r| r["level"].is_empty() && r["update"].is_empty()), "a still has no levels");
     // One whole order per (model, method): 80 and 32 triangles, three methods, none clustered.
     assert_eq!(rows.len(), 2 * 3);

@@ -34,7 +34,10 @@ use crate::order::{
     sander07::sander07,
     tipsify::tipsify,
 };
-use crate::raster::{RasterBackend, ViewSet, cpu::CpuRaster};
+use rayon::prelude::*;
+
+use crate::measure::translucency;
+use crate::raster::{RasterBackend, ViewSet, cpu, cpu::CpuRaster};
 
 /// One timed comparison.
 #[derive(Debug, Clone)]
@@ -188,6 +191,21 @@ pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
     rows.push(row(&format!("overdraw axis6@256, {threads} threads"), ours, Some(theirs)));
     let ico = median_seconds(reps.min(5), overdraw(ViewSet::Ico(162), 512));
     rows.push(row("overdraw ico:162@512", ico, None));
+    // The translucency metric of the input order (issue 18: under 2 s on a 100k mesh).
+    let ids: Vec<u32> = (0..drawn.len() as u32).collect();
+    let cameras = ViewSet::Ico(162).cameras(framing, 0);
+    let blend = median_seconds(reps.min(5), || {
+        let errors: Vec<_> = cameras
+            .par_iter()
+            .map(|camera| {
+                let mut fragments = Vec::new();
+                cpu::fragments(positions, drawn, camera, 512, &mut fragments).ok();
+                translucency::view_error(&fragments, &ids, 512)
+            })
+            .collect();
+        black_box(errors);
+    });
+    rows.push(row("translucency ico:162@512 (blend vs exact)", blend, None));
     rows
 }
 

@@ -349,6 +349,16 @@ fn drawn_one(
         }
         _ => String::new(),
     };
+    let translucency = match spec.figure.kind {
+        FigureKind::Translucency => {
+            let camera = views::drawing_camera(&mesh.positions, spec.figure.view);
+            let mut fragments = Vec::new();
+            cpu::fragments(&mesh.positions, &triangles, &camera, views::DRAWING_RES, &mut fragments)?;
+            let picture = measure::translucency::error_picture(&fragments, &buffer.order, views::DRAWING_RES);
+            base64::engine::general_purpose::STANDARD.encode(OrderRow::encode_counts(&picture, views::DRAWING_RES)?)
+        }
+        _ => String::new(),
+    };
     Ok(OrderRow {
         model: model.to_string(),
         method: evaluation.method.clone(),
@@ -356,6 +366,7 @@ fn drawn_one(
         clusters: words(&mut buffer.starts.iter().map(usize::to_string)),
         corners,
         overdraw,
+        translucency,
         level: String::new(),
         update: String::new(),
     })

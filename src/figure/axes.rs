@@ -128,7 +128,7 @@ pub struct Colors(Vec<(String, RGBColor)>);
 /// Methods with a palette slot of their own, in slot order: the file's order and the worst case.
 const RESERVED: [&str; 2] = ["input", "random"];
 
-const PALETTE: [RGBColor; 20] = [
+const PALETTE: [RGBColor; 28] = [
     RGBColor(0x4d, 0x4d, 0x4d), // grey
     RGBColor(0xe1, 0x57, 0x59), // red
     RGBColor(0x4e, 0x79, 0xa7), // blue
@@ -149,6 +149,14 @@ const PALETTE: [RGBColor; 20] = [
     RGBColor(0x00, 0x80, 0x80), // dark teal
     RGBColor(0xc0, 0x40, 0x00), // rust
     RGBColor(0x99, 0x99, 0xff), // lavender
+    RGBColor(0xa6, 0xce, 0xe3), // light blue
+    RGBColor(0xb8, 0x86, 0x0b), // dark gold
+    RGBColor(0x4b, 0x00, 0x82), // indigo
+    RGBColor(0x9a, 0xcd, 0x32), // yellow-green
+    RGBColor(0x80, 0x00, 0x00), // maroon
+    RGBColor(0x70, 0x80, 0x90), // slate
+    RGBColor(0x2f, 0x4f, 0x4f), // dark slate
+    RGBColor(0xc7, 0x15, 0x85), // violet red
 ];
 
 impl Colors {

@@ -66,6 +66,9 @@ enum Content {
     /// Fragments shaded at each pixel of the figure's view, as the run saved them
     /// ([`views::DRAWING_RES`]² pixels, row 0 at the bottom).
     Overdraw(Vec<u32>),
+    /// Where the translucent blend goes wrong at each pixel of the figure's view, as the run saved
+    /// it (`measure::translucency::error_picture`'s levels, same layout).
+    Translucency(Vec<u32>),
 }
 
 /// Per drawn triangle: its cluster's colour and index. Distinct colours are golden-ratio hues;
@@ -190,17 +193,23 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
                     FigureKind::Clusters => (Content::Clusters(cluster_colours(&starts, false)), clusters),
                     FigureKind::ClusterOrder => (Content::Clusters(cluster_colours(&starts, true)), clusters),
                     _ => {
+                        let (column, what) = match kind {
+                            FigureKind::Translucency => (&row.translucency, "translucency error"),
+                            _ => (&row.overdraw, "overdraw"),
+                        };
+                        let picture = |e: String| stale(format!("the {what} picture of `{method}` on `{model}`: {e}"));
                         let bytes = base64::engine::general_purpose::STANDARD
-                            .decode(&row.overdraw)
-                            .map_err(|e| stale(format!("the overdraw picture of `{method}` on `{model}`: {e}")))?;
-                        let (res, shaded) = OrderRow::decode_counts(&bytes)
-                            .map_err(|e| stale(format!("the overdraw picture of `{method}` on `{model}`: {e}")))?;
+                            .decode(column)
+                            .map_err(|e| picture(e.to_string()))?;
+                        let (res, levels) = OrderRow::decode_counts(&bytes).map_err(picture)?;
                         if res != views::DRAWING_RES {
-                            return Err(stale(format!(
-                                "the overdraw picture of `{method}` on `{model}` is {res}² pixels"
-                            )));
+                            return Err(picture(format!("{res}² pixels")));
                         }
-                        (Content::Overdraw(shaded), String::new())
+                        let content = match kind {
+                            FigureKind::Translucency => Content::Translucency(levels),
+                            _ => Content::Overdraw(levels),
+                        };
+                        (content, String::new())
                     }
                 };
                 drawings.push(Drawing {
@@ -495,12 +504,14 @@ fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std
                     let k = (shaded[y * n + x] as usize).clamp(1, OVERDRAW_GREYS.len());
                     ([OVERDRAW_GREYS[k - 1]; 3], false)
                 }
+                Content::Translucency(levels) => (error_colour(levels[y * n + x]), false),
                 Content::Sequence { .. } => unreachable!("sequences are drawn as polygons"),
             };
             let [pa, pb, pc] = tri.map(|v| positions[v as usize]);
             let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
             // Overdraw greys carry the data, so their facets are shaded only lightly.
-            let relief = if matches!(drawing.kind, Content::Overdraw(_)) { 0.15 } else { 0.5 };
+            let relief =
+                if matches!(drawing.kind, Content::Overdraw(_) | Content::Translucency(_)) { 0.15 } else { 0.5 };
             let mut shade = 1.0 - relief + relief * normal.dot(-place.camera.forward).abs();
             if border {
                 shade *= 0.6;
@@ -552,12 +563,33 @@ fn legend(root: &super::axes::Area, kind: &Content, y: i32) -> DrawResult {
             &[([0, 0, 0], "first cluster drawn"), ([108, 108, 108], "…"), ([LAST_GREY; 3], "last cluster drawn")],
         ),
         Content::Clusters(_) => root.draw_text("colour: cluster (facets shaded by angle to the view)", &style, (12, y)),
+        Content::Translucency(_) => swatches(
+            root,
+            y,
+            &[
+                (error_colour(1), "blended right"),
+                (error_colour(2), "visibly wrong (1/255)"),
+                (error_colour(17), "16/255"),
+                (error_colour(65), "64/255 or more"),
+            ],
+        ),
         Content::Overdraw(_) => {
             let labels = ["1 fragment shaded", "2", "3", "4", "5 or more"];
             let entries: Vec<([u8; 3], &str)> = OVERDRAW_GREYS.iter().map(|&g| [g, g, g]).zip(labels).collect();
             swatches(root, y, &entries)
         }
     }
+}
+
+/// The colour of a translucency error level: light grey where the blend is right, then red from
+/// light (just visible, 1/255) to dark (a large error, 64/255 or more).
+fn error_colour(level: u32) -> [u8; 3] {
+    if level <= 1 {
+        return [225, 225, 225];
+    }
+    let t = ((level - 1) as f32 / 64.0).min(1.0);
+    let mix = |light: f32, dark: f32| (light + (dark - light) * t).round() as u8;
+    [mix(250.0, 120.0), mix(150.0, 0.0), mix(150.0, 0.0)]
 }
 
 /// A row of colour swatches with labels.

@@ -108,7 +108,8 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         | FigureKind::Corners
         | FigureKind::Clusters
         | FigureKind::ClusterOrder
-        | FigureKind::Overdraw => return drawing::plot(chart, &table),
+        | FigureKind::Overdraw
+        | FigureKind::Translucency => return drawing::plot(chart, &table),
         FigureKind::HardwareFit => return hardware_fit::plot(chart, &table),
         FigureKind::Ratio => return ratio::plot(chart, &table),
     };

@@ -97,6 +97,11 @@ pub enum FigureKind {
     /// Each (model, method) drawn as a heat map of the fragments shaded at each pixel from the
     /// figure's view: darker, more overdraw (Nehab et al. 2006, Fig. 1).
     Overdraw,
+    /// Each (model, method) drawn with where its translucent blend goes wrong from the figure's
+    /// view: grey where blending in draw order gives the exact colour, red where it is visibly
+    /// wrong, darker the larger the error (seed 003's "per-triangle" speckle against consistent
+    /// regions; `measure::translucency`).
+    Translucency,
     /// Which simulated cache model predicts the vertex-shader invocations counted on the GPU
     /// (caches must list simulated models and `gpu`): every model ranked by its error, and the
     /// winner's simulated against counted ACMR (issue 6).
@@ -123,6 +128,7 @@ impl FigureKind {
                 | FigureKind::Clusters
                 | FigureKind::ClusterOrder
                 | FigureKind::Overdraw
+                | FigureKind::Translucency
         )
     }
 }
@@ -351,6 +357,7 @@ pub fn kind_name(kind: FigureKind) -> &'static str {
         FigureKind::Clusters => "clusters",
         FigureKind::ClusterOrder => "cluster-order",
         FigureKind::Overdraw => "overdraw",
+        FigureKind::Translucency => "translucency",
         FigureKind::Corners => "corners",
         FigureKind::HardwareFit => "hardware-fit",
         FigureKind::Ratio => "ratio",

@@ -69,9 +69,10 @@ pub fn colour(id: u32) -> [f32; 3] {
     [0, 21, 42].map(|shift| ((x >> shift) & 0x1F_FFFF) as f32 / 0x1F_FFFF as f32)
 }
 
-/// The error of drawing `fragments` (one view's, in draw order; `ids[t]` the triangle id of drawn
-/// triangle `t`) blended in draw order, against the exact back-to-front blend, on a `res`² image.
-pub fn view_error(fragments: &[Fragment], ids: &[u32], res: u32) -> ViewError {
+/// Visits every pixel the `fragments` cover (one view's, in draw order; `ids[t]` the triangle id
+/// of drawn triangle `t`; a `res`² image) with its colour blended in draw order, its exact colour
+/// (blended back to front) and its fragment pairs blended nearer first.
+fn blend_pixels(fragments: &[Fragment], ids: &[u32], res: u32, mut visit: impl FnMut(usize, [f32; 3], [f32; 3], u64)) {
     // The fragments grouped by pixel, each pixel's in draw order (a counting sort, stable).
     let pixels = (res as usize) * (res as usize);
     let mut start = vec![0u32; pixels + 1];
@@ -87,36 +88,56 @@ pub fn view_error(fragments: &[Fragment], ids: &[u32], res: u32) -> ViewError {
         grouped[next[f.pixel as usize] as usize] = i as u32;
         next[f.pixel as usize] += 1;
     }
-    let mut error = ViewError::default();
+    let blend = |order: &[u32]| {
+        order.iter().fold([0f32; 3], |c, &i| {
+            let own = colour(ids[fragments[i as usize].triangle as usize]);
+            [0, 1, 2].map(|k| c[k] * (1.0 - ALPHA) + own[k] * ALPHA)
+        })
+    };
     let mut far_first: Vec<u32> = Vec::new();
     for p in 0..pixels {
         let here = &grouped[start[p] as usize..start[p + 1] as usize];
         if here.is_empty() {
             continue;
         }
-        error.covered += 1;
         if here.len() == 1 {
+            let only = blend(here);
+            visit(p, only, only, 0);
             continue;
         }
         let depth = |i: u32| fragments[i as usize].depth;
-        for (a, &i) in here.iter().enumerate() {
-            error.pairs += here[a + 1..].iter().filter(|&&j| depth(i) < depth(j)).count() as u64;
-        }
+        let pairs = here.iter().enumerate().map(|(a, &i)| here[a + 1..].iter().filter(|&&j| depth(i) < depth(j)).count() as u64).sum();
         far_first.clear();
         far_first.extend_from_slice(here);
         far_first.sort_by(|&i, &j| depth(j).total_cmp(&depth(i)));
-        let blend = |order: &[u32]| {
-            order.iter().fold([0f32; 3], |c, &i| {
-                let own = colour(ids[fragments[i as usize].triangle as usize]);
-                [0, 1, 2].map(|k| c[k] * (1.0 - ALPHA) + own[k] * ALPHA)
-            })
-        };
-        let (drawn, exact) = (blend(here), blend(&far_first));
+        visit(p, blend(here), blend(&far_first), pairs);
+    }
+}
+
+/// The error of drawing `fragments` (one view's, in draw order; `ids[t]` the triangle id of drawn
+/// triangle `t`) blended in draw order, against the exact back-to-front blend, on a `res`² image.
+pub fn view_error(fragments: &[Fragment], ids: &[u32], res: u32) -> ViewError {
+    let mut error = ViewError::default();
+    blend_pixels(fragments, ids, res, |_, drawn, exact, pairs| {
         let differences = [0, 1, 2].map(|k| drawn[k] - exact[k]);
+        error.covered += 1;
+        error.pairs += pairs;
         error.squared += differences.iter().map(|d| f64::from(*d) * f64::from(*d)).sum::<f64>();
         error.wrong += u64::from(differences.iter().any(|d| d.abs() > VISIBLE));
-    }
+    });
     error
+}
+
+/// Where the errors fall, per pixel of a `res`² image (row 0 at the bottom): 0 where nothing is
+/// drawn, 1 where the blend is right (within 1/255), and 2 to 255 where it is visibly wrong, by
+/// the largest channel difference in 1/255 steps (saturating). What a figure of the errors draws.
+pub fn error_picture(fragments: &[Fragment], ids: &[u32], res: u32) -> Vec<u32> {
+    let mut picture = vec![0u32; (res as usize) * (res as usize)];
+    blend_pixels(fragments, ids, res, |p, drawn, exact, _| {
+        let worst = (0..3).map(|k| (drawn[k] - exact[k]).abs()).fold(0.0f32, f32::max);
+        picture[p] = if worst > VISIBLE { 1 + ((worst * 255.0).round() as u32).clamp(1, 254) } else { 1 };
+    });
+    picture
 }
 
 /// The translucency error over the view set.

@@ -231,7 +231,8 @@ fn model_base(name: &str, source: &Source) -> String {
 }
 
 /// The orders file's header, in order (checked against [`OrderRow`] by a test).
-pub const ORDER_COLUMNS: &[&str] = &["model", "method", "order", "clusters", "corners", "overdraw", "level", "update"];
+pub const ORDER_COLUMNS: &[&str] =
+    &["model", "method", "order", "clusters", "corners", "overdraw", "level", "update", "translucency"];
 
 /// One line of a drawing spec's orders file: a whole order, the triangle ids in draw order
 /// separated by spaces (one line per order keeps the file a seventh of one row per triangle).
@@ -256,6 +257,11 @@ pub struct OrderRow {
     pub level: String,
     #[serde(default)]
     pub update: String,
+    /// For `translucency` drawings: where the translucent blend goes wrong from the figure's view,
+    /// a greyscale PNG in base64 of [`crate::measure::translucency::error_picture`]'s levels.
+    /// Empty otherwise (and in orders files written before it existed).
+    #[serde(default)]
+    pub translucency: String,
 }
 
 /// The digits of [`OrderRow::encode_corners`].
@@ -380,6 +386,7 @@ mod tests {
             overdraw: String::new(),
             level: String::new(),
             update: String::new(),
+            translucency: String::new(),
         };
         let mut writer = csv::Writer::from_writer(Vec::new());
         writer.serialize(&order).unwrap();
