@@ -190,8 +190,29 @@ fn cache_metrics_do_not_depend_on_scale_or_place() {
 /// searches break by face id), which the copy's rounding separates one way or the other: other
 /// clusters form, and another order follows. No normalization can undo a rounding of the input.
 /// Scaled by a power of two, or moved, a copy is the same bits in the unit frame, and there every
-/// method, `nehab` included, gives the original's order.
-const ROUNDING_SENSITIVE: &[(&str, &str)] = &[("nehab", "sphere:2000"), ("nehab", "helix:3")];
+/// method, `nehab` included, gives the original's order. `translucent-dist-angle` and
+/// `translucent-per-view` sort by one number per triangle (its normal against its centroid, its
+/// depth from each of 162 viewpoints), on any mesh (`*`): on the symmetric sphere and helix many
+/// triangles share that number, and the copy's rounding splits those ties one way or the other.
+/// The translucent
+/// pair sorts (`translucent-topo`, `-coverage`, `-peeling`) find their pairs by rasterizing, on
+/// any mesh (`*`): a rounded copy moves a few fragments (the overdraw test above finds 4 in 6.8
+/// million), which changes the samples two triangles share, and with them arc weights and
+/// coverage sums.
+const ROUNDING_SENSITIVE: &[(&str, &str)] = &[
+    ("nehab", "sphere:2000"),
+    ("nehab", "helix:3"),
+    ("translucent-dist-angle", "*"),
+    ("translucent-per-view", "*"),
+    ("translucent-topo", "*"),
+    ("translucent-coverage", "*"),
+    ("translucent-peeling", "*"),
+];
+
+/// Whether `method` on `mesh` is listed in [`ROUNDING_SENSITIVE`].
+fn rounding_sensitive(method: &str, mesh: &str) -> bool {
+    ROUNDING_SENSITIVE.iter().any(|&(m, on)| m == method && (on == "*" || on == mesh))
+}
 
 /// Every registered method, per-node ones included (their buffers and lookup), gives the same
 /// orders for every copy as for its original; the only exceptions, listed and explained in
@@ -215,9 +236,12 @@ fn every_method_orders_every_copy_as_the_original() {
                 }
                 let want = &wants.iter().find(|(m, _)| m.positions == original.positions).unwrap().1;
                 let got = run(placed);
-                if rounded(copy) && ROUNDING_SENSITIVE.contains(&(method.name, mesh.name.as_str())) {
+                // A decimal rescale rounds every coordinate; a power of two can too, where it takes
+                // a near-zero coordinate (the helix's -2.9e-18) below f32's range.
+                let unit = |m: &Mesh| Framing::of(&m.positions).unit_positions(&m.positions);
+                let exact = !rounded(copy) && unit(original) == unit(placed);
+                if !exact && rounding_sensitive(method.name, &mesh.name) {
                     let moved = want.0[0].order.iter().zip(&got.0[0].order).filter(|(a, b)| a != b).count();
-                    let unit = |m: &Mesh| Framing::of(&m.positions).unit_positions(&m.positions);
                     let (a, b) = (unit(original), unit(placed));
                     let differ = a.iter().zip(&b).map(|(p, q)| (0..3).filter(|&i| p[i] != q[i]).count()).sum::<usize>();
                     eprintln!(

@@ -43,10 +43,16 @@ pub struct Framing {
 impl Framing {
     /// The centre of the frame of `positions`: the middle of their bounding box, in f64.
     pub fn center_of(positions: &[Vec3]) -> DVec3 {
+        let (lo, hi) = Framing::bounds_of(positions);
+        (lo + hi) * 0.5
+    }
+
+    /// The corners of the bounding box of `positions` (zero for none).
+    pub fn bounds_of(positions: &[Vec3]) -> (DVec3, DVec3) {
         let (lo, hi) = positions
             .iter()
             .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        if positions.is_empty() { DVec3::ZERO } else { (lo.as_dvec3() + hi.as_dvec3()) * 0.5 }
+        if positions.is_empty() { (DVec3::ZERO, DVec3::ZERO) } else { (lo.as_dvec3(), hi.as_dvec3()) }
     }
 
     /// The unit frame itself: positions already centred and of radius 1 map to themselves.

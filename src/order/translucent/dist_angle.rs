@@ -8,8 +8,8 @@
 //! far wall of a fold) is drawn before the outward-facing surface that covers it. Its errors come
 //! "across entire slabs" rather than per triangle, which the translucency metric's error images
 //! show. O(n log n). The centre is the middle of the bounding box, as the unit frame's
-//! ([`Framing`]); the products are taken in f64 from it, so a moved or scaled copy sorts the same;
-//! ties keep the input order.
+//! ([`Framing`]); the products are taken relative to the box, so a moved copy, or one scaled by a
+//! power of two, sorts the same; ties keep the input order.
 
 use glam::Vec3;
 
@@ -37,11 +37,19 @@ struct DistAngle;
 impl Ordering for DistAngle {
     fn order(&self, scene: &Scene) -> Result<Orders> {
         let mesh = &scene.mesh;
-        let center = Framing::center_of(&mesh.positions);
-        // Positions from the centre: exact in f64 (f32 values and a midpoint of two), then
-        // rounded to f32, so shifting the mesh or scaling it by a power of two changes no key's
-        // order; the products are taken in f32 from there.
-        let from_center: Vec<Vec3> = mesh.positions.iter().map(|p| (p.as_dvec3() - center).as_vec3()).collect();
+        // Centred on the bounding box and divided by its largest side, in f64, then rounded to
+        // f32: a copy moved, or scaled by a power of two, has the same positions there, and a
+        // tiny or huge mesh neither underflows nor overflows in the cross product (which squares
+        // the scale). (The unit frame's radius would do as well, at the cost of a pass with a
+        // square root per vertex.) On a copy rounded by a decimal rescale, triangles whose keys
+        // were equal (a symmetric mesh has many) may split either way: `tests/scale_invariance.rs`
+        // lists it.
+        let (lo, hi) = Framing::bounds_of(&mesh.positions);
+        let center = (lo + hi) * 0.5;
+        let side = (hi - lo).max_element();
+        let scale = if side > 0.0 { 1.0 / side } else { 1.0 };
+        let from_center: Vec<Vec3> =
+            mesh.positions.iter().map(|p| ((p.as_dvec3() - center) * scale).as_vec3()).collect();
         let keys: Vec<u32> = mesh
             .triangles
             .iter()
@@ -49,7 +57,8 @@ impl Ordering for DistAngle {
                 let [a, b, c] = t.map(|v| from_center[v as usize]);
                 let normal = (b - a).cross(c - a);
                 let length = normal.length();
-                sortable(if length > 0.0 { normal.dot(a + b + c) / (3.0 * length) } else { 0.0 })
+                // (The centroid's 1/3 is common to every key: left out.)
+                sortable(if length > 0.0 { normal.dot(a + b + c) / length } else { 0.0 })
             })
             .collect();
         Ok(Orders::from(radix_order(&keys)))

@@ -4,7 +4,7 @@
 //! nearest the eye (and by keyframe for an animation), as Han & Sander 2017's are ([`Lookup`]),
 //! so from its own viewpoints it is the centroid sort exactly. It is not exact per pixel: two
 //! triangles whose centroids sort one way can overlap the other way (long thin ones, or ones that
-//! cross). Depths are the sums of the three corner depths in f64, in the unit frame, as
+//! cross). Depths are the sums of the three corner depths in f64 from the frame's centre, as
 //! `front-to-back` takes them; ties keep the input order.
 
 use glam::DVec3;
@@ -55,7 +55,11 @@ impl Ordering for PerView {
         }
         let mut buffers = Vec::with_capacity(count);
         for f in 0..frames.len() {
-            let unit: Vec<DVec3> = frames.frames[f].iter().map(|&p| frames.framing.to_unit64(p)).collect();
+            // From the centre, not divided by the radius (which would not change the order, but
+            // its rounding would break exact ties differently in a rescaled copy), as
+            // `front-to-back` takes them.
+            let center = frames.framing.center;
+            let unit: Vec<DVec3> = frames.frames[f].iter().map(|&p| p.as_dvec3() - center).collect();
             let triangles = frames.triangles(f, &scene.mesh);
             for direction in &directions {
                 let d = direction.as_dvec3();
