@@ -8,11 +8,9 @@
 //! zero unless the covering triangle lies in front of the covered one and faces away from it).
 //! O(n²) time and O(n) memory in the blog; here O(P + n log n) for the P overlapping pairs.
 
-use super::super::{Cost, Method, Order, Ordering, Orders, Params};
+use super::super::{Cost, Method, Order, Ordering, Params};
+use super::pair_sort;
 use super::pairs;
-use super::params;
-use crate::error::Result;
-use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "translucent-coverage",
@@ -21,28 +19,20 @@ pub static METHOD: Method = Method {
     peer: false,
     per_node: false,
     cost: Cost::Heavy,
-    params: &[params::VIEWS, params::RES],
+    params: &[pair_sort::VIEWS, pair_sort::RES],
     build,
 };
 
-fn build(p: &Params) -> Box<dyn Ordering> {
-    let (views, res) = params::read(p);
-    Box::new(Coverage { views, res })
+fn build(params: &Params) -> Box<dyn Ordering> {
+    pair_sort::build(params, sort)
 }
 
-struct Coverage {
-    views: u32,
-    res: u32,
-}
-
-impl Ordering for Coverage {
-    fn order(&self, scene: &Scene) -> Result<Orders> {
-        let facets = pairs::facets(scene);
-        let covered = covered(&facets, &pairs::overlapping(scene, self.views, self.res)?);
-        let mut order: Order = (0..facets.len() as u32).collect();
-        order.sort_by(|&a, &b| covered[b as usize].total_cmp(&covered[a as usize]));
-        Ok(Orders::from(order))
-    }
+/// Most covered first.
+fn sort(facets: &[pairs::Facet], overlapping: &[pairs::Pair]) -> Order {
+    let covered = covered(facets, overlapping);
+    let mut order: Order = (0..facets.len() as u32).collect();
+    order.sort_by(|&a, &b| covered[b as usize].total_cmp(&covered[a as usize]));
+    order
 }
 
 /// Per triangle, how much the triangles it overlaps cover it.

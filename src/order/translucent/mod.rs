@@ -5,8 +5,8 @@
 
 pub mod coverage;
 pub mod dist_angle;
+mod pair_sort;
 pub mod pairs;
-mod params;
 pub mod peeling;
 pub mod per_view;
 pub mod topo;

@@ -16,11 +16,9 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use super::super::{Cost, Method, Order, Ordering, Orders, Params};
+use super::super::{Cost, Method, Order, Ordering, Params};
+use super::pair_sort;
 use super::pairs::{self, Facet, Pair};
-use super::params;
-use crate::error::Result;
-use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "translucent-peeling",
@@ -29,25 +27,12 @@ pub static METHOD: Method = Method {
     peer: false,
     per_node: false,
     cost: Cost::Heavy,
-    params: &[params::VIEWS, params::RES],
+    params: &[pair_sort::VIEWS, pair_sort::RES],
     build,
 };
 
-fn build(p: &Params) -> Box<dyn Ordering> {
-    let (views, res) = params::read(p);
-    Box::new(Peeling { views, res })
-}
-
-struct Peeling {
-    views: u32,
-    res: u32,
-}
-
-impl Ordering for Peeling {
-    fn order(&self, scene: &Scene) -> Result<Orders> {
-        let facets = pairs::facets(scene);
-        Ok(Orders::from(peel(&facets, &pairs::overlapping(scene, self.views, self.res)?)))
-    }
+fn build(params: &Params) -> Box<dyn Ordering> {
+    pair_sort::build(params, peel)
 }
 
 /// The draw order coverage peeling gives over `overlapping` pairs.

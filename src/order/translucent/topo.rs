@@ -21,11 +21,9 @@
 
 use std::collections::BinaryHeap;
 
-use super::super::{Cost, Method, Order, Ordering, Orders, Params};
+use super::super::{Cost, Method, Order, Ordering, Params};
+use super::pair_sort;
 use super::pairs::{self, Facet, Pair};
-use super::params;
-use crate::error::Result;
-use crate::mesh::Scene;
 
 pub static METHOD: Method = Method {
     name: "translucent-topo",
@@ -34,26 +32,12 @@ pub static METHOD: Method = Method {
     peer: false,
     per_node: false,
     cost: Cost::Heavy,
-    params: &[params::VIEWS, params::RES],
+    params: &[pair_sort::VIEWS, pair_sort::RES],
     build,
 };
 
-fn build(p: &Params) -> Box<dyn Ordering> {
-    let (views, res) = params::read(p);
-    Box::new(Topo { views, res })
-}
-
-struct Topo {
-    views: u32,
-    res: u32,
-}
-
-impl Ordering for Topo {
-    fn order(&self, scene: &Scene) -> Result<Orders> {
-        let facets = pairs::facets(scene);
-        let arcs = arcs(&facets, &pairs::overlapping(scene, self.views, self.res)?);
-        Ok(Orders::from(sort(facets.len(), &arcs)))
-    }
+fn build(params: &Params) -> Box<dyn Ordering> {
+    pair_sort::build(params, |facets, overlapping| sort(facets.len(), &arcs(facets, overlapping)))
 }
 
 /// The weighted arcs `(from, to, weight)` the predicates give.
