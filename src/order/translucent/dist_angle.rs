@@ -50,18 +50,21 @@ impl Ordering for DistAngle {
         let scale = if side > 0.0 { 1.0 / side } else { 1.0 };
         let from_center: Vec<Vec3> =
             mesh.positions.iter().map(|p| ((p.as_dvec3() - center) * scale).as_vec3()).collect();
-        let keys: Vec<u32> = mesh
+        // Each key above its triangle's id, ready for the sort.
+        let words: Vec<u64> = mesh
             .triangles
             .iter()
-            .map(|t| {
+            .enumerate()
+            .map(|(id, t)| {
                 let [a, b, c] = t.map(|v| from_center[v as usize]);
                 let normal = (b - a).cross(c - a);
                 let length = normal.length();
                 // (The centroid's 1/3 is common to every key: left out.)
-                sortable(if length > 0.0 { normal.dot(a + b + c) / length } else { 0.0 })
+                let key = sortable(if length > 0.0 { normal.dot(a + b + c) / length } else { 0.0 });
+                u64::from(key) << 32 | id as u64
             })
             .collect();
-        Ok(Orders::from(radix_order(&keys)))
+        Ok(Orders::from(radix_order(words)))
     }
 }
 
@@ -71,13 +74,12 @@ fn sortable(x: f32) -> u32 {
     if bits >> 31 == 1 { !bits } else { bits | 0x8000_0000 }
 }
 
-/// The ids `0..keys.len()` sorted by key, ties in id order: a least-significant-digit radix sort
-/// of (key, id) words, three passes of 11 bits with the three histograms counted in one sweep
+/// The ids in the low halves of `words` sorted by the keys in their high halves, ties in id
+/// order: a least-significant-digit radix sort of the words, three passes of 11 bits with the three histograms counted in one sweep
 /// (linear where a comparison sort is not); small inputs are sorted as integers.
-fn radix_order(keys: &[u32]) -> Order {
+fn radix_order(mut words: Vec<u64>) -> Order {
     const BITS: u32 = 11;
     const BUCKETS: usize = 1 << BITS;
-    let mut words: Vec<u64> = keys.iter().enumerate().map(|(id, &k)| u64::from(k) << 32 | id as u64).collect();
     // Below a few thousand words the histograms cost more than the sort: sort the words (the id
     // in their low bits breaks ties as the radix sort does).
     if words.len() < 4 * BUCKETS {
@@ -117,10 +119,11 @@ mod tests {
         // Enough values for the radix passes, with repeats for ties.
         let many: Vec<f32> = (0..20_000).map(|i| ((i * 7919) % 1000) as f32 * 0.37 - 150.0).collect();
         for values in [&few[..], &many[..]] {
-            let keys: Vec<u32> = values.iter().map(|&v| sortable(v)).collect();
+            let words: Vec<u64> =
+                values.iter().enumerate().map(|(id, &v)| u64::from(sortable(v)) << 32 | id as u64).collect();
             let mut expected: Vec<u32> = (0..values.len() as u32).collect();
             expected.sort_by(|&a, &b| values[a as usize].total_cmp(&values[b as usize]));
-            assert_eq!(radix_order(&keys), expected);
+            assert_eq!(radix_order(words), expected);
         }
     }
 }
