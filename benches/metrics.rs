@@ -1,4 +1,5 @@
-//! Criterion benchmarks: our cache simulators and rasterizer beside meshoptimizer's analyzers
+//! Criterion benchmarks: our cache simulators (FIFO, batch, LRU) and rasterizer (on the default
+//! threads and on one, as meshoptimizer runs) beside meshoptimizer's analyzers
 //! on the same index buffers in the same run (`cargo bench`). `triorder bench` prints the same
 //! comparison as a ratio table; this file gives criterion's confidence intervals.
 //!
@@ -43,6 +44,13 @@ fn benches(c: &mut Criterion) {
     let cameras = ViewSet::Axis6.cameras(Framing::of(&mesh.positions), 0);
     group.bench_function("triorder axis6@256", |b| {
         b.iter(|| CpuRaster.count(&mesh.positions, black_box(&triangles), &cameras, 256).unwrap())
+    });
+    // meshoptimizer rasterises on one thread: the like-for-like comparison.
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
+    group.bench_function("triorder axis6@256, 1 thread", |b| {
+        b.iter(|| {
+            one_thread.install(|| CpuRaster.count(&mesh.positions, black_box(&triangles), &cameras, 256).unwrap())
+        })
     });
     let adapter = mesh.meshopt_positions();
     group.bench_function("meshopt analyzeOverdraw (6 views@256)", |b| {

@@ -23,11 +23,20 @@ fn describe(gpu: &crate::gpu::Gpu) -> String {
     format!("{}{software}", gpu.describe())
 }
 
+/// One spec run and plotted: its id, CSV, SVG, and the wall time of both.
+#[derive(Debug, Clone)]
+pub struct Ran {
+    pub id: String,
+    pub csv: PathBuf,
+    pub svg: PathBuf,
+    pub seconds: f64,
+}
+
 /// What [`reproduce`] did.
 #[derive(Debug, Clone, Default)]
 pub struct Outcome {
-    /// Each spec run and plotted: its id, CSV and SVG.
-    pub ran: Vec<(String, PathBuf, PathBuf)>,
+    /// Each spec run and plotted, in the order run.
+    pub ran: Vec<Ran>,
     /// Each spec skipped, and why.
     pub skipped: Vec<(String, String)>,
     /// Each model (and method) that failed in a spec, which went on without it: the spec's id and
@@ -79,10 +88,11 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
             overall.inc(1);
             continue;
         }
+        let spec_start = Instant::now();
         let run = run_spec(spec, opts, &bars)?;
         outcome.failures.extend(run.failures.into_iter().map(|f| (spec.id.clone(), f)));
         let svg = figure::plot(&spec.chart(&plot))?;
-        outcome.ran.push((spec.id.clone(), run.csv, svg));
+        outcome.ran.push(Ran { id: spec.id.clone(), csv: run.csv, svg, seconds: spec_start.elapsed().as_secs_f64() });
         overall.inc(1);
     }
     overall.finish_and_clear();

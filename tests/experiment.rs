@@ -433,10 +433,9 @@ fn reproduce_runs_and_plots_every_matching_spec_in_order() {
     common::write_spec(root.path(), "tiny", TINY);
     common::write_spec(root.path(), "another", &TINY.replace("id = \"tiny\"", "id = \"another\""));
     let outputs = reproduce(&quick(root.path()), None).unwrap().ran;
-    let ids: Vec<_> =
-        outputs.iter().map(|(_, csv, _)| csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
+    let ids: Vec<_> = outputs.iter().map(|ran| ran.csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
     assert_eq!(ids, ["another", "tiny"]);
-    assert!(outputs.iter().all(|(_, csv, svg)| csv.is_file() && svg.is_file()));
+    assert!(outputs.iter().all(|ran| ran.csv.is_file() && ran.svg.is_file() && ran.seconds > 0.0));
     assert_eq!(reproduce(&quick(root.path()), Some("tin")).unwrap().ran.len(), 1);
     let err = reproduce(&quick(root.path()), Some("nothing")).unwrap_err().to_string();
     assert!(err.contains("matching `nothing`"), "{err}");

@@ -79,8 +79,8 @@ pub fn plot(spec: &Path, quick: bool, common: &Common) -> Result<()> {
 
 pub fn reproduce(quick: bool, only: Option<&str>, backend: Option<String>, common: &Common) -> Result<()> {
     let outcome = reproduce::reproduce(&run_options(quick, backend, common)?, only)?;
-    for (_, csv, svg) in &outcome.ran {
-        println!("wrote {} and {}", csv.display(), svg.display());
+    for ran in &outcome.ran {
+        println!("wrote {} and {} ({:.1} s)", ran.csv.display(), ran.svg.display(), ran.seconds);
     }
     print!("{}", summary(&outcome, quick));
     Ok(())
@@ -96,6 +96,12 @@ fn summary(outcome: &reproduce::Outcome, quick: bool) -> String {
         outcome.ran.len(),
         if quick { " (quick: procedural models and assets/ only, small view sets)" } else { "" }
     );
+    let mut slowest: Vec<&reproduce::Ran> = outcome.ran.iter().collect();
+    slowest.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
+    if slowest.len() > 1 {
+        let five: Vec<String> = slowest.iter().take(5).map(|r| format!("{} {:.0} s", r.id, r.seconds)).collect();
+        out += &format!("  slowest: {}\n", five.join(", "));
+    }
     for (id, why) in &outcome.skipped {
         out += &format!("  skipped {id}: {why}\n");
     }
@@ -117,6 +123,11 @@ fn summary(outcome: &reproduce::Outcome, quick: bool) -> String {
 /// procedural sphere of similar size and the bundled cow.
 const BENCH_MODELS: [&str; 3] =
     ["models/bun_zipper.ply", "models/happy_buddha_100k.obj", "models/dragon_vrip_res2.ply"];
+/// A row's spread as `low–high` (the quartiles of its per-round speedups), `-` without a peer.
+fn spread(row: &triorder::experiment::bench::BenchRow) -> String {
+    row.spread.map_or("-".to_string(), |(low, high)| format!("{low:.2}–{high:.2}"))
+}
+
 const BENCH_FALLBACK: [&str; 2] = ["sphere:100000", "assets/spot.obj"];
 
 pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &Common) -> Result<()> {
@@ -129,7 +140,9 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
         .map(|model| Source::parse(model)?.open(data.as_deref(), common.seed).map(|scene| (*model, scene)))
         .collect::<Result<Vec<_>>>()?;
     println!("machine: {}", provenance::machine());
-    println!("median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster)");
+    println!(
+        "median of {reps} runs; speedup = meshopt time / our time (> 1: we are faster); spread = quartiles of the per-round speedups (ours and meshopt's take turns in each round)"
+    );
     if only == Some(BenchPart::Backends) {
         let gpu = measure::backend("gpu")?;
         println!("\noverdraw counting, GPU backend vs CPU (ratio = GPU time / CPU time; < 1: the GPU is faster)");
@@ -185,21 +198,22 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
     }
     if only != Some(BenchPart::Orderings) {
         println!(
-            "\n{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8}",
-            "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup"
+            "\n{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8} {:>11}",
+            "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup", "spread"
         );
         for (model, scene) in &scenes {
             for r in triorder::experiment::bench::compare(&scene.mesh, reps) {
                 let theirs = r.meshopt_seconds.map_or("-".to_string(), |s| format!("{:.3}", s * 1e3));
                 let speedup = r.speedup().map_or("-".to_string(), |s| format!("{s:.2}x"));
                 println!(
-                    "{:<28} {:>9}  {:<46} {:>10.3} {:>10} {:>8}",
+                    "{:<28} {:>9}  {:<46} {:>10.3} {:>10} {:>8} {:>11}",
                     model,
                     r.triangles,
                     r.task,
                     r.ours_seconds * 1e3,
                     theirs,
-                    speedup
+                    speedup,
+                    spread(&r)
                 );
             }
         }
@@ -207,20 +221,21 @@ pub fn bench(reps: usize, meshes: &[String], only: Option<BenchPart>, common: &C
     if only != Some(BenchPart::Metrics) {
         println!("\norderings on the input order as loaded; ACMR at fifo:16 (ratio = ours / meshopt)");
         println!(
-            "{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8} {:>8} {:>8} {:>7}",
-            "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup", "ACMR", "meshopt", "ratio"
+            "{:<28} {:>9}  {:<46} {:>10} {:>10} {:>8} {:>11} {:>8} {:>8} {:>7}",
+            "mesh", "triangles", "task", "ours ms", "meshopt ms", "speedup", "spread", "ACMR", "meshopt", "ratio"
         );
         for (model, scene) in &scenes {
             for r in triorder::experiment::bench::compare_orderings(scene, reps) {
                 let (ours, theirs) = r.acmr.unwrap_or((f64::NAN, f64::NAN));
                 println!(
-                    "{:<28} {:>9}  {:<46} {:>10.3} {:>10.3} {:>7.2}x {:>8.4} {:>8.4} {:>7.4}",
+                    "{:<28} {:>9}  {:<46} {:>10.3} {:>10.3} {:>7.2}x {:>11} {:>8.4} {:>8.4} {:>7.4}",
                     model,
                     r.triangles,
                     r.task,
                     r.ours_seconds * 1e3,
                     r.meshopt_seconds.unwrap_or(f64::NAN) * 1e3,
                     r.speedup().unwrap_or(f64::NAN),
+                    spread(&r),
                     ours,
                     theirs,
                     ours / theirs

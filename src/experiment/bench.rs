@@ -48,6 +48,9 @@ pub struct BenchRow {
     pub ours_seconds: f64,
     /// `None` where meshopt has no equivalent.
     pub meshopt_seconds: Option<f64>,
+    /// The lower and upper quartile of the per-round speedups (meshopt ÷ ours, timed in the same
+    /// round), where meshopt has an equivalent: how far one round's ratio strays from another's.
+    pub spread: Option<(f64, f64)>,
     /// For orderings: the ACMR at FIFO-16 of our order and of meshopt's.
     pub acmr: Option<(f64, f64)>,
 }
@@ -61,22 +64,32 @@ impl BenchRow {
 
 /// Median wall time of `reps` calls of `f`.
 pub fn median_seconds(reps: usize, mut f: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..reps.max(1))
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64()
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
+    median(
+        (0..reps.max(1))
+            .map(|_| {
+                let start = Instant::now();
+                f();
+                start.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
 }
 
-/// Median wall time of each of `fs` over `reps` rounds. The functions take turns within a round,
+fn median(samples: Vec<f64>) -> f64 {
+    quantile(samples, 0.5)
+}
+
+/// The `q`-quantile of `samples` (nearest rank; the middle one for 0.5 and an odd count).
+fn quantile(mut samples: Vec<f64>, q: f64) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples[((samples.len() - 1) as f64 * q).round() as usize]
+}
+
+/// The wall times of each of `fs` over `reps` rounds. The functions take turns within a round,
 /// so that a change in machine load (other processes, clock boost) hits all of them alike; each
 /// timed call follows an untimed call of the same function, so each is timed with its own data in
 /// cache, as in a loop of calls, rather than with whatever the previous function left there.
-pub fn median_interleaved<const N: usize>(reps: usize, mut fs: [&mut dyn FnMut(); N]) -> [f64; N] {
+pub fn interleaved<const N: usize>(reps: usize, mut fs: [&mut dyn FnMut(); N]) -> [Vec<f64>; N] {
     let mut times = [(); N].map(|_| Vec::with_capacity(reps.max(1)));
     for _ in 0..reps.max(1) {
         for (f, t) in fs.iter_mut().zip(&mut times) {
@@ -86,10 +99,18 @@ pub fn median_interleaved<const N: usize>(reps: usize, mut fs: [&mut dyn FnMut()
             t.push(start.elapsed().as_secs_f64());
         }
     }
-    times.map(|mut t| {
-        t.sort_by(f64::total_cmp);
-        t[t.len() / 2]
-    })
+    times
+}
+
+/// Median wall time of each of `fs` over `reps` interleaved rounds ([`interleaved`]).
+pub fn median_interleaved<const N: usize>(reps: usize, fs: [&mut dyn FnMut(); N]) -> [f64; N] {
+    interleaved(reps, fs).map(median)
+}
+
+/// The median times of ours and meshopt's, and the quartiles of the per-round speedups.
+fn against(ours: &[f64], theirs: &[f64]) -> (f64, f64, (f64, f64)) {
+    let ratios: Vec<f64> = theirs.iter().zip(ours).map(|(t, o)| t / o).collect();
+    (median(ours.to_vec()), median(theirs.to_vec()), (quantile(ratios.clone(), 0.25), quantile(ratios, 0.75)))
 }
 
 /// One timing of the two raster backends on the same work.
@@ -141,54 +162,53 @@ pub fn compare(mesh: &Mesh, reps: usize) -> Vec<BenchRow> {
     let indices = meshopt::optimize_vertex_cache(&mesh.index_buffer(), mesh.vertex_count());
     let triangles: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let n = mesh.vertex_count();
-    let row = |task: &str, ours: f64, theirs: Option<f64>| BenchRow {
+    let row = |task: &str, ours: f64, theirs: Option<(f64, (f64, f64))>| BenchRow {
         mesh: mesh.name.clone(),
         triangles: mesh.triangle_count(),
         task: task.to_string(),
         ours_seconds: ours,
-        meshopt_seconds: theirs,
+        meshopt_seconds: theirs.map(|t| t.0),
+        spread: theirs.map(|t| t.1),
         acmr: None,
+    };
+    let peer = |task: &str, [ours, theirs]: [Vec<f64>; 2]| {
+        let (ours, theirs, spread) = against(&ours, &theirs);
+        row(task, ours, Some((theirs, spread)))
     };
     let mut rows = Vec::new();
     for (model, (c, w, p)) in
         [(CacheModel::Fifo(16), (16, 0, 0)), (CacheModel::Batch { cache: 32, warp: 32, primgroup: 32 }, (32, 32, 32))]
     {
-        let ours = median_seconds(reps, || {
-            std::hint::black_box(simulate(model, std::hint::black_box(&triangles), n));
-        });
-        let theirs = median_seconds(reps, || {
-            std::hint::black_box(meshopt::analyze_vertex_cache(std::hint::black_box(&indices), n, c, w, p));
-        });
-        rows.push(row(&format!("cache {model}"), ours, Some(theirs)));
+        let times = interleaved(
+            reps,
+            [&mut || _ = black_box(simulate(model, black_box(&triangles), n)), &mut || {
+                _ = black_box(meshopt::analyze_vertex_cache(black_box(&indices), n, c, w, p))
+            }],
+        );
+        rows.push(peer(&format!("cache {model}"), times));
     }
-    let lru = median_seconds(reps, || {
-        std::hint::black_box(simulate(CacheModel::Lru(16), &triangles, n));
-    });
+    let lru = median_seconds(reps, || _ = black_box(simulate(CacheModel::Lru(16), black_box(&triangles), n)));
     rows.push(row("cache lru:16", lru, None));
 
     let framing = Framing::of(&mesh.positions);
     let (positions, drawn) = (&mesh.positions, &triangles);
     let overdraw = |views: ViewSet, res: u32| {
         let cameras = views.cameras(framing, 0);
-        move || {
-            std::hint::black_box(CpuRaster.count(positions, drawn, &cameras, res).ok());
-        }
+        move || drop(black_box(CpuRaster.count(positions, black_box(drawn), &cameras, res).ok()))
     };
     let adapter = mesh.meshopt_positions();
-    let theirs = median_seconds(reps, || {
-        std::hint::black_box(meshopt::analyze_overdraw(&indices, &adapter));
-    });
+    let mut theirs = || _ = black_box(meshopt::analyze_overdraw(black_box(&indices), &adapter));
     // meshopt rasterises on one thread; compare like with like first, then our default.
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().map(|pool| {
-        let mut time = overdraw(ViewSet::Axis6, 256);
-        pool.install(|| median_seconds(reps, &mut time))
+        let mut ours = overdraw(ViewSet::Axis6, 256);
+        pool.install(|| interleaved(reps, [&mut ours, &mut theirs]))
     });
-    if let Ok(ours) = one_thread {
-        rows.push(row("overdraw axis6@256, 1 thread (meshopt: 6 views@256)", ours, Some(theirs)));
+    if let Ok(times) = one_thread {
+        rows.push(peer("overdraw axis6@256, 1 thread (meshopt: 6 views@256)", times));
     }
-    let ours = median_seconds(reps, overdraw(ViewSet::Axis6, 256));
     let threads = rayon::current_num_threads();
-    rows.push(row(&format!("overdraw axis6@256, {threads} threads"), ours, Some(theirs)));
+    let times = interleaved(reps, [&mut overdraw(ViewSet::Axis6, 256), &mut theirs]);
+    rows.push(peer(&format!("overdraw axis6@256, {threads} threads"), times));
     let ico = median_seconds(reps.min(5), overdraw(ViewSet::Ico(162), 512));
     rows.push(row("overdraw ico:162@512", ico, None));
     // The translucency metric of the input order (issue 18: under 2 s on a 100k mesh).
@@ -222,18 +242,22 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
     };
     let theirs_acmr =
         |indices: Vec<u32>| fifo16(&indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<_>>());
-    let row = |task: &str, ours: f64, theirs: f64, acmr: (f64, f64)| BenchRow {
-        mesh: mesh.name.clone(),
-        triangles: mesh.triangle_count(),
-        task: task.to_string(),
-        ours_seconds: ours,
-        meshopt_seconds: Some(theirs),
-        acmr: Some(acmr),
+    let row = |task: &str, [theirs, ours]: [&Vec<f64>; 2], acmr: (f64, f64)| {
+        let (ours, theirs, spread) = against(ours, theirs);
+        BenchRow {
+            mesh: mesh.name.clone(),
+            triangles: mesh.triangle_count(),
+            task: task.to_string(),
+            ours_seconds: ours,
+            meshopt_seconds: Some(theirs),
+            spread: Some(spread),
+            acmr: Some(acmr),
+        }
     };
     let triangles = &mesh.triangles;
 
     let fifo_acmr = (ours_acmr("tipsify:cache=16"), theirs_acmr(meshopt::optimize_vertex_cache_fifo(&indices, n, 16)));
-    let [fifo_theirs, ours, with_adjacency] = median_interleaved(
+    let [fifo_theirs, ours, with_adjacency] = interleaved(
         reps,
         [
             &mut || drop(black_box(meshopt::optimize_vertex_cache_fifo(black_box(&indices), n, 16))),
@@ -245,14 +269,14 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
     // meshoptimizer's linear FIFO optimizer.
     let dist_angle = order::resolve("translucent-dist-angle", 0).expect("a registered method");
     let dist_acmr = (ours_acmr("translucent-dist-angle"), fifo_acmr.1);
-    let [dist_theirs, dist_ours] = median_interleaved(
+    let [dist_theirs, dist_ours] = interleaved(
         reps,
         [&mut || drop(black_box(meshopt::optimize_vertex_cache_fifo(black_box(&indices), n, 16))), &mut || {
             drop(black_box(dist_angle.ordering.order(black_box(scene))))
         }],
     );
     let vcache_acmr = (ours_acmr("forsyth:cache=32"), theirs_acmr(meshopt::optimize_vertex_cache(&indices, n)));
-    let [vcache_theirs, forsyth_ours, forsyth_with_adjacency] = median_interleaved(
+    let [vcache_theirs, forsyth_ours, forsyth_with_adjacency] = interleaved(
         reps,
         [
             &mut || drop(black_box(meshopt::optimize_vertex_cache(black_box(&indices), n))),
@@ -267,7 +291,7 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
         indices
     };
     let overdraw_acmr = (ours_acmr("sander07:cache=16,lambda=0.85"), theirs_acmr(overdraw_theirs()));
-    let [overdraw_theirs, sander_ours, sander_with_adjacency] = median_interleaved(
+    let [overdraw_theirs, sander_ours, sander_with_adjacency] = interleaved(
         reps,
         [
             &mut || drop(black_box(overdraw_theirs())),
@@ -276,13 +300,13 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
         ],
     );
     vec![
-        row("tipsify:cache=16 vs optimizeVertexCacheFifo(16)", ours, fifo_theirs, fifo_acmr),
-        row("  the same, + adjacency", with_adjacency, fifo_theirs, fifo_acmr),
-        row("translucent-dist-angle vs optimizeVertexCacheFifo", dist_ours, dist_theirs, dist_acmr),
-        row("forsyth:cache=32 vs optimizeVertexCache", forsyth_ours, vcache_theirs, vcache_acmr),
-        row("  the same, + adjacency", forsyth_with_adjacency, vcache_theirs, vcache_acmr),
-        row("sander07 vs optimizeVertexCache+Overdraw(1.05)", sander_ours, overdraw_theirs, overdraw_acmr),
-        row("  the same, + adjacency", sander_with_adjacency, overdraw_theirs, overdraw_acmr),
+        row("tipsify:cache=16 vs optimizeVertexCacheFifo(16)", [&fifo_theirs, &ours], fifo_acmr),
+        row("  the same, + adjacency", [&fifo_theirs, &with_adjacency], fifo_acmr),
+        row("translucent-dist-angle vs optimizeVertexCacheFifo", [&dist_theirs, &dist_ours], dist_acmr),
+        row("forsyth:cache=32 vs optimizeVertexCache", [&vcache_theirs, &forsyth_ours], vcache_acmr),
+        row("  the same, + adjacency", [&vcache_theirs, &forsyth_with_adjacency], vcache_acmr),
+        row("sander07 vs optimizeVertexCache+Overdraw(1.05)", [&overdraw_theirs, &sander_ours], overdraw_acmr),
+        row("  the same, + adjacency", [&overdraw_theirs, &sander_with_adjacency], overdraw_acmr),
     ]
 }
 

@@ -1,0 +1,43 @@
+//! Criterion benchmarks: our cache orderings beside their meshoptimizer peers on the same mesh in
+//! the same run (`cargo bench --bench orderings`): `forsyth` (LRU 32, tuned scores) against
+//! `optimizeVertexCache`, `tipsify:cache=16` against `optimizeVertexCacheFifo(16)`. Ours run as
+//! triorder runs them, from the mesh's vertex→triangle adjacency built once per mesh; `triorder
+//! bench --only orderings` also times them with that adjacency built inside, and prints ratios.
+//!
+//! Uses the shared bunny (69,451 triangles) when ../shared/data exists, else a procedural sphere.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use triorder::mesh::{Scene, Source, source};
+use triorder::order;
+
+fn scene() -> Scene {
+    let data = source::data_dir(None).or_else(|| Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")));
+    let open = |name: &str| Source::parse(name)?.open(data.as_deref(), 0);
+    open("models/bun_zipper.ply").or_else(|_| open("sphere:70000")).expect("a benchmark mesh")
+}
+
+fn benches(c: &mut Criterion) {
+    let scene = scene();
+    let (indices, n) = (scene.mesh.index_buffer(), scene.mesh.vertex_count());
+    let mut group = c.benchmark_group(format!("orderings, {} triangles", scene.mesh.triangle_count()));
+    group.sample_size(20);
+    for (ours, theirs) in
+        [("forsyth", "meshopt optimizeVertexCache"), ("tipsify:cache=16", "meshopt optimizeVertexCacheFifo(16)")]
+    {
+        let method = order::resolve(ours, 0).expect("a registered method");
+        group.bench_function(format!("triorder {ours}"), |b| b.iter(|| method.ordering.order(black_box(&scene))));
+        group.bench_function(theirs, |b| {
+            b.iter(|| match ours {
+                "forsyth" => meshopt::optimize_vertex_cache(black_box(&indices), n),
+                _ => meshopt::optimize_vertex_cache_fifo(black_box(&indices), n, 16),
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(orderings, benches);
+criterion_main!(orderings);
