@@ -48,9 +48,11 @@ struct Common {
 /// What to measure, as in `eval` and `order`.
 #[derive(Args, Clone)]
 struct Measure {
-    /// Vertex-cache model(s): fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP, or `gpu` to count
-    /// vertex-shader invocations on the GPU (pipeline statistics). Repeatable; the first model is
-    /// the one summarised. Default fifo:16.
+    /// Vertex-cache model(s): fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP; nvidia, amd or intel
+    /// (the vendors' batches and reuse from published measurements: Kerbl et al. 2018 for NVIDIA
+    /// and AMD, Kapoulkine 2017 for Intel; `triorder methods` gives their parameters); or `gpu` to
+    /// count vertex-shader invocations on the GPU (pipeline statistics). Repeatable; the first
+    /// model is the one summarised. Default fifo:16.
     #[arg(long = "cache", value_name = "MODEL")]
     caches: Vec<String>,
     /// Measure overdraw over a view set: axis6, ico:N (12, 42, 162, 642, 2562) or random:N.

@@ -10,6 +10,7 @@ pub use experiments::{bench, merge, plot, reproduce, run};
 use std::path::Path;
 
 use triorder::gpu::render_time::{MAX_FRAMES, Shading};
+use triorder::measure::vendor::Vendor;
 use triorder::measure::{self, CacheModel, MeasureOptions, Measured};
 use triorder::mesh::gltf::animation::ClipSelection;
 use triorder::mesh::progressive::Update;
@@ -90,6 +91,13 @@ pub fn methods() -> Result<()> {
             println!("    {}={default}  ({}) {}", p.name, describe_kind(p.kind), p.help);
         }
         println!();
+    }
+    println!(
+        "Cache models (--cache, and `caches` in specs): fifo:K, lru:K, batch:CACHE,WARP,PRIMGROUP\n\
+         (meshoptimizer's analyzeVertexCache), and the GPU vendors' models from published measurements:"
+    );
+    for vendor in Vendor::ALL {
+        println!("  {:<7} {}", vendor.name(), vendor.describe());
     }
     Ok(())
 }

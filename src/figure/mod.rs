@@ -101,7 +101,9 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         }
         FigureKind::Table => {
             panels = table.select(figure)?;
-            let best_per_column = figure.series == "metric";
+            // Methods are what a table compares: when they are the rows, the best is marked
+            // down each column; so too when the columns are different metrics.
+            let best_per_column = figure.series == "metric" || figure.x.as_deref() == Some("method");
             Box::new(table::Tables { bars: bar::Bars::new(&panels), best_per_column })
         }
         FigureKind::Sequence

@@ -13,9 +13,11 @@ use std::fmt;
 use std::str::FromStr;
 
 use super::{CacheColumn, Draws, MeasureOptions, Metric, Name, Value};
+use super::vendor::Vendor;
 use crate::error::{Error, Result};
 
-/// A vertex-cache model, written `fifo:16`, `lru:32` or `batch:CACHE,WARP,PRIMGROUP`.
+/// A vertex-cache model, written `fifo:16`, `lru:32`, `batch:CACHE,WARP,PRIMGROUP`, or a GPU
+/// vendor's model from published measurements: `nvidia`, `amd` or `intel` ([`Vendor`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CacheModel {
     /// First in, first out: a miss pushes the vertex and evicts the oldest; a hit changes nothing.
@@ -26,6 +28,8 @@ pub enum CacheModel {
     /// before a triangle whose missing vertices would overflow `warp` vertices or when the batch
     /// already holds `primgroup` triangles; 0 turns a limit off.
     Batch { cache: u32, warp: u32, primgroup: u32 },
+    /// A GPU vendor's batches and reuse, as measured ([`super::vendor`]).
+    Vendor(Vendor),
 }
 
 /// Largest cache we simulate: timestamps are u32 and must not wrap within a mesh.
@@ -37,15 +41,17 @@ impl CacheModel {
         match *self {
             CacheModel::Fifo(k) | CacheModel::Lru(k) => k,
             CacheModel::Batch { cache, .. } => cache,
+            CacheModel::Vendor(vendor) => vendor.size(),
         }
     }
 
-    /// The model's family name: `fifo`, `lru` or `batch`.
+    /// The model's family name: `fifo`, `lru`, `batch`, or the vendor's.
     pub fn kind(&self) -> &'static str {
         match self {
             CacheModel::Fifo(_) => "fifo",
             CacheModel::Lru(_) => "lru",
             CacheModel::Batch { .. } => "batch",
+            CacheModel::Vendor(vendor) => vendor.name(),
         }
     }
 }
@@ -56,6 +62,7 @@ impl fmt::Display for CacheModel {
             CacheModel::Fifo(k) => write!(f, "fifo:{k}"),
             CacheModel::Lru(k) => write!(f, "lru:{k}"),
             CacheModel::Batch { cache, warp, primgroup } => write!(f, "batch:{cache},{warp},{primgroup}"),
+            CacheModel::Vendor(vendor) => write!(f, "{vendor}"),
         }
     }
 }
@@ -66,10 +73,15 @@ impl FromStr for CacheModel {
     fn from_str(text: &str) -> Result<CacheModel> {
         let bad = |why: &str| {
             Error::usage(format!(
-                "cache model `{text}` {why} (expected fifo:K, lru:K or batch:CACHE,WARP,PRIMGROUP, e.g. fifo:16, batch:32,32,32)"
+                "cache model `{text}` {why} (expected fifo:K, lru:K, batch:CACHE,WARP,PRIMGROUP, nvidia, amd or intel, e.g. fifo:16, batch:32,32,32; `triorder methods` describes them)"
             ))
         };
-        let (kind, args) = text.split_once(':').ok_or_else(|| bad("has no size"))?;
+        if let Some(vendor) = Vendor::parse(text) {
+            return Ok(CacheModel::Vendor(vendor));
+        }
+        let (kind, args) = text
+            .split_once(':')
+            .ok_or_else(|| bad(if ["fifo", "lru", "batch"].contains(&text) { "has no size" } else { "is of an unknown kind" }))?;
         let numbers: Vec<u32> = args
             .split(',')
             .map(|a| a.trim().parse::<u32>())
@@ -102,7 +114,8 @@ pub struct CacheStats {
     pub vertices: usize,
     /// Vertices transformed (cache misses).
     pub misses: u64,
-    /// Batches (warps) executed; only the batch model counts them, 0 otherwise.
+    /// Batches (warps) executed; only the batch model and the NVIDIA and AMD models (batches and
+    /// waves) count them, 0 otherwise.
     pub batches: u64,
 }
 
@@ -155,13 +168,14 @@ fn run(model: CacheModel, triangles: &[[u32; 3]], vertex_count: usize, on_miss: 
         CacheModel::Fifo(k) => fifo(k, triangles, vertex_count, on_miss),
         CacheModel::Lru(k) => lru(k, triangles, vertex_count, on_miss),
         CacheModel::Batch { cache, warp, primgroup } => batch(cache, warp, primgroup, triangles, vertex_count, on_miss),
+        CacheModel::Vendor(vendor) => vendor.simulate(triangles, vertex_count, on_miss),
     }
 }
 
 /// FIFO by timestamps: `stamp[v]` is the miss count when v last entered; v is cached iff fewer
 /// than k misses happened since. Stamps start at k+1 so an untouched vertex (stamp 0) misses, and
 /// a non-zero stamp marks a referenced vertex.
-fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize, mut on_miss: impl FnMut(usize)) -> CacheStats {
+pub(crate) fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize, mut on_miss: impl FnMut(usize)) -> CacheStats {
     let mut stamp = vec![0u32; vertex_count];
     let mut now = k + 1;
     for (t, tri) in triangles.iter().enumerate() {

@@ -46,6 +46,9 @@ macro_rules! registry {
 
 registry![cache, gpu_vertices, overdraw, render, translucency];
 
+/// The GPU vendors' cache models, which the `cache` metric simulates.
+pub mod vendor;
+
 /// What the ordering itself reports, beside the metrics: every row of a run also carries the
 /// ordering's time, and runs that compare methods with several buffers say how many each needs.
 pub static ORDERING: &[Name] = &[
