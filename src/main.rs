@@ -74,6 +74,11 @@ struct Measure {
     /// pixel (CPU reference rasterizer).
     #[arg(long)]
     translucency: bool,
+    /// Also measure the meshlets each order makes (meshoptimizer's scan builder, 64 vertices and
+    /// 124 triangles, and its optimized builder as the peer): count, fill, vertices per triangle,
+    /// and with --views the share of meshlets a normal cone culls.
+    #[arg(long)]
+    meshlets: bool,
     /// Raster backend for overdraw: cpu (the reference rasterizer) or gpu (Vulkan through wgpu;
     /// Mesa's lavapipe will do where there is no GPU).
     #[arg(long, default_value = "cpu", value_name = "cpu|gpu")]

@@ -59,6 +59,7 @@ impl Measuring {
             render_frames: m.render_frames,
             per_draw_call: false,
             translucency: m.translucency,
+            meshlets: m.meshlets,
         };
         Ok(Measuring { options, raster })
     }

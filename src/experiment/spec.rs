@@ -41,6 +41,8 @@
 //! render_frames = 30               # optional: timed frames per view and shader (default 30)
 //! translucency = true              # optional, with views: also measure how wrong each order
 //!                                  # is blended as a translucent mesh (measure/translucency.rs)
+//! meshlets = true                  # optional: also measure the meshlets the order makes
+//!                                  # (measure/meshlets.rs; cone culling needs views)
 //! levels = [1.0, 0.5, 0.25]        # optional: measure each static model as a progressive mesh
 //!                                  # at these fractions of its triangles (rows name `level`)
 //! updates = ["simple", "smart"]    # optional, with levels: how each method's sequence follows
@@ -135,6 +137,8 @@ pub struct Spec {
     pub render: Vec<Shading>,
     /// Also measure the translucency error over the view set (`translucency = true`).
     pub translucency: bool,
+    /// Also measure the meshlets each order makes (`meshlets = true`).
+    pub meshlets: bool,
     /// Canonical method specs (every parameter written out), grids expanded, duplicates
     /// removed, in the order the spec lists them.
     pub methods: Vec<String>,
@@ -207,6 +211,7 @@ impl Spec {
             // Specs measure whole meshes, as the papers do.
             per_draw_call: false,
             translucency: self.translucency,
+            meshlets: self.meshlets,
         }
     }
 
@@ -278,6 +283,8 @@ struct RawSpec {
     updates: Vec<String>,
     #[serde(default)]
     translucency: bool,
+    #[serde(default)]
+    meshlets: bool,
     figure: RawFigure,
     quick: Option<RawQuick>,
 }
@@ -405,6 +412,7 @@ impl RawSpec {
             views: full.views,
             render: render.clone(),
             translucency: self.translucency,
+            meshlets: self.meshlets,
             ..Default::default()
         };
         let writes = Writes {
@@ -443,6 +451,7 @@ impl RawSpec {
             backend,
             render,
             translucency: self.translucency,
+            meshlets: self.meshlets,
             methods,
             updates,
             full,

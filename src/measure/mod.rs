@@ -44,7 +44,7 @@ macro_rules! registry {
     };
 }
 
-registry![cache, gpu_vertices, overdraw, render, translucency];
+registry![cache, gpu_vertices, overdraw, render, translucency, meshlets];
 
 /// The GPU vendors' cache models, which the `cache` metric simulates.
 pub mod vendor;
@@ -127,6 +127,8 @@ pub struct MeasureOptions {
     /// Also measure how wrong each order is for translucent rendering over the view set
     /// ([`translucency`]).
     pub translucency: bool,
+    /// Also measure the meshlets each order makes ([`meshlets`]).
+    pub meshlets: bool,
 }
 
 impl MeasureOptions {
