@@ -103,7 +103,8 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
             panels = table.select(figure)?;
             // Methods are what a table compares: when they are the rows, the best is marked
             // down each column; so too when the columns are different metrics.
-            let best_per_column = figure.series == "metric" || figure.x.as_deref() == Some("method");
+            let best_per_column =
+                figure.series == "metric" || matches!(figure.x.as_deref(), Some("method" | "method_name"));
             Box::new(table::Tables { bars: bar::Bars::new(&panels), best_per_column })
         }
         FigureKind::Sequence

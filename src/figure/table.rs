@@ -2,7 +2,7 @@
 //! method), the metric in each cell — for the papers' tables (Bogomjakov & Gotsman 2002 Tables 1
 //! and 2), where the reader compares numbers, not shapes. The best value is bold, lower being
 //! better for all of ours (misses, overdraw, blending errors, time): the best method of each row,
-//! or of each column when the rows are the methods (`x = "method"`) or the columns are different
+//! or of each column when the rows are the methods (`x = "method"` or `"method_name"`) or the columns are different
 //! metrics (`series = "metric"`), which only compare within themselves.
 
 use plotters::prelude::*;
