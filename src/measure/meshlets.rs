@@ -21,10 +21,11 @@
 //! Buffers count as often as draws use them, as for the cache metrics; cone tests use each
 //! frame's positions and the buffer that draws each view.
 
-use meshopt::{Meshlets, VertexDataAdapter};
+use meshopt::Meshlets;
 
 use super::{Draws, MeasureOptions, Metric, Name, Value};
 use crate::error::Result;
+use crate::mesh::meshopt_positions;
 use crate::raster::Camera;
 
 /// The common mesh-shader limits (NVIDIA's recommendation; meshoptimizer's default example).
@@ -87,8 +88,7 @@ impl Metric for MeshletMetrics {
 
     fn measure(&self, draws: &Draws) -> Result<Vec<Value>> {
         let vertex_count = draws.scene.mesh.vertex_count();
-        let rest = VertexDataAdapter::new(meshopt::typed_to_bytes(&draws.scene.mesh.positions), 12, 0)
-            .expect("Vec3 slices are a whole number of 12-byte vertices");
+        let rest = draws.scene.mesh.meshopt_positions();
         let buffers: Vec<[Meshlets; 2]> = (0..draws.orders.buffers.len())
             .map(|b| {
                 let indices: Vec<u32> = draws.triangles(b).into_iter().flatten().collect();
@@ -122,8 +122,7 @@ impl Metric for MeshletMetrics {
                 let name = if suffix.is_empty() { "meshlet_cone_culled" } else { "meshlet_cone_culled_optimized" };
                 let (mut culled, mut views) = (0.0, 0usize);
                 for f in draws.frames.clone() {
-                    let positions = VertexDataAdapter::new(meshopt::typed_to_bytes(draws.positions(f)), 12, 0)
-                        .expect("Vec3 slices are a whole number of 12-byte vertices");
+                    let positions = meshopt_positions(draws.positions(f));
                     for (b, group) in draws.groups(f) {
                         let meshlets = &buffers[b][builder];
                         let bounds: Vec<meshopt::Bounds> =

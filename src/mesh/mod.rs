@@ -125,9 +125,7 @@ impl Mesh {
 
     /// The positions as meshoptimizer reads them: tightly packed `[f32; 3]`.
     pub fn meshopt_positions(&self) -> meshopt::VertexDataAdapter<'_> {
-        let bytes = meshopt::typed_to_bytes(&self.positions);
-        meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<Vec3>(), 0)
-            .expect("Vec3 slices are a whole number of 12-byte vertices")
+        meshopt_positions(&self.positions)
     }
 
     /// The triangles in the order `order` (new position → old triangle id). The caller guarantees
@@ -200,4 +198,11 @@ impl Mesh {
 /// `values` permuted so that element `i` of the result is `values[index[i]]`.
 fn gather<T: Copy>(values: &[T], index: &[u32]) -> Vec<T> {
     index.iter().map(|&i| values[i as usize]).collect()
+}
+
+/// `positions` as meshoptimizer reads them: tightly packed `[f32; 3]` (a mesh's, a keyframe's or
+/// the unit-frame copy the cameras see).
+pub fn meshopt_positions(positions: &[Vec3]) -> meshopt::VertexDataAdapter<'_> {
+    meshopt::VertexDataAdapter::new(meshopt::typed_to_bytes(positions), std::mem::size_of::<Vec3>(), 0)
+        .expect("Vec3 slices are a whole number of 12-byte vertices")
 }

@@ -9,12 +9,10 @@
 //! the origin its centroids lose their offsets to rounding; each gave another order for the same
 //! shape.
 
-use glam::Vec3;
-
 use super::order_from_index_buffer;
 use crate::error::Result;
-use crate::mesh::Scene;
 use crate::mesh::frames::unit_positions;
+use crate::mesh::{Scene, meshopt_positions};
 use crate::order::{Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 
 const THRESHOLD: ParamInfo = ParamInfo {
@@ -48,9 +46,7 @@ impl Ordering for MeshoptOverdraw {
         let mesh = &scene.mesh;
         let mut indices = meshopt::optimize_vertex_cache(&mesh.index_buffer(), mesh.vertex_count());
         let unit = unit_positions(&mesh.positions);
-        let positions = meshopt::VertexDataAdapter::new(meshopt::typed_to_bytes(&unit), size_of::<Vec3>(), 0)
-            .expect("Vec3 slices are a whole number of 12-byte vertices");
-        meshopt::optimize_overdraw_in_place(&mut indices, &positions, self.threshold);
+        meshopt::optimize_overdraw_in_place(&mut indices, &meshopt_positions(&unit), self.threshold);
         order_from_index_buffer(mesh, &scene.topology, &indices).map(Orders::from)
     }
 }
