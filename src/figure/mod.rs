@@ -89,7 +89,7 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         FigureKind::Line | FigureKind::Scatter => {
             panels = table.select(figure)?;
             let x = figure.x.as_deref().unwrap_or_default();
-            Box::new(xy::Xy::new(&panels, x, figure.kind == FigureKind::Line, csv)?)
+            Box::new(xy::Xy::new(&panels, x, figure.kind == FigureKind::Line, &figure.highlight, csv)?)
         }
         FigureKind::Bar => {
             panels = table.select(figure)?;

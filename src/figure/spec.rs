@@ -64,6 +64,9 @@ pub struct Figure {
     pub view: [f32; 3],
     /// Kind `ratio`: the method names whose values are divided, numerator first.
     pub ratio: Option<(String, String)>,
+    /// Line and scatter charts of methods: the method names drawn on top with larger, outlined
+    /// markers (a new method and its peers among every ordering, issue 19).
+    pub highlight: Vec<String>,
 }
 
 /// The chart kinds `triorder plot` draws.
@@ -153,6 +156,8 @@ pub struct RawFigure {
     label: Option<String>,
     view: Option<[f32; 3]>,
     ratio: Option<[String; 2]>,
+    #[serde(default)]
+    highlight: Vec<String>,
 }
 
 /// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
@@ -317,6 +322,17 @@ impl RawFigure {
             }
             (_, None) => None,
         };
+        if !self.highlight.is_empty() {
+            if !matches!(self.kind, FigureKind::Line | FigureKind::Scatter)
+                || !matches!(series.as_str(), "method" | "method_name")
+            {
+                return Err("figure.highlight is for line and scatter charts whose series are methods (series = \"method_name\")".into());
+            }
+            let names: Vec<&str> = methods.iter().map(|m| m.split(':').next().unwrap_or(m)).collect();
+            if let Some(missing) = self.highlight.iter().find(|n| !names.contains(&n.as_str())) {
+                return Err(format!("figure.highlight names `{missing}`, which is not a method of this spec"));
+            }
+        }
         let y_range = match self.y_range {
             Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
                 return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
@@ -342,6 +358,7 @@ impl RawFigure {
             label: self.label,
             view,
             ratio,
+            highlight: self.highlight,
         })
     }
 }

@@ -21,12 +21,15 @@ type Curve = (String, Vec<(f64, f64)>);
 pub struct Xy {
     panels: Vec<Vec<Curve>>,
     lines: bool,
+    /// Method names whose series are drawn last, with larger outlined markers.
+    highlight: Vec<String>,
 }
 
 impl Xy {
     /// Parses every x as a number (`x` names the column, `csv` the file, for errors); `lines`
-    /// joins each series' points in x order, otherwise they are a scatter.
-    pub fn new(panels: &[Panel], x: &str, lines: bool, csv: &Path) -> Result<Xy> {
+    /// joins each series' points in x order, otherwise they are a scatter; the series of the
+    /// methods named in `highlight` are drawn on top of the others.
+    pub fn new(panels: &[Panel], x: &str, lines: bool, highlight: &[String], csv: &Path) -> Result<Xy> {
         let panels = panels
             .iter()
             .map(|panel| {
@@ -51,7 +54,7 @@ impl Xy {
                     .collect::<Result<Vec<_>>>()
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Xy { panels, lines })
+        Ok(Xy { panels, lines, highlight: highlight.to_vec() })
     }
 
     /// The points of panel `panel`, or of every panel.
@@ -77,7 +80,8 @@ impl Kind for Xy {
     }
 
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult {
-        axes::panel(area, title, frame, &XyPainter { series: &self.panels[index], colors, lines: self.lines })
+        let painter = XyPainter { series: &self.panels[index], colors, lines: self.lines, highlight: &self.highlight };
+        axes::panel(area, title, frame, &painter)
     }
 }
 
@@ -85,6 +89,7 @@ struct XyPainter<'a> {
     series: &'a [Curve],
     colors: &'a Colors,
     lines: bool,
+    highlight: &'a [String],
 }
 
 impl Painter for XyPainter<'_> {
@@ -93,9 +98,18 @@ impl Painter for XyPainter<'_> {
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        for (name, points) in self.series {
+        let highlighted = |name: &str| self.highlight.iter().any(|h| name.split(':').next() == Some(h.as_str()));
+        // The others first, so that the highlighted series are never hidden under them.
+        let (on_top, rest): (Vec<&Curve>, Vec<&Curve>) = self.series.iter().partition(|(name, _)| highlighted(name));
+        for (name, points) in rest.into_iter().chain(on_top) {
             let color = self.colors.of(name);
-            if self.lines {
+            if highlighted(name) {
+                if self.lines {
+                    chart.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(3)))?;
+                }
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 6, color.filled())))?;
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 6, BLACK.stroke_width(2))))?;
+            } else if self.lines {
                 chart.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))?;
                 if points.len() <= MAX_MARKED_POINTS {
                     chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;

@@ -122,6 +122,7 @@ registry![
     meshopt::fifo,
     sander07,
     meshopt::overdraw,
+    cheap_cuts,
     nehab,
     front_to_back,
     tipsify_per_frame,
