@@ -18,6 +18,9 @@
 //!   `sander07` (Tipsify, fast linear clustering with λ = 0.85, dot-rule sort) is timed against
 //!   `optimizeVertexCache` followed by `optimizeOverdraw` (threshold 1.05), meshoptimizer's take
 //!   on the same paper; their overdraw is compared in the experiments (it needs rendering).
+//!   `cheap-cuts` (ours, issue 19) is timed against the same pair, with its adjacency given and
+//!   its 42-view overdraw graph on as many threads as `RAYON_NUM_THREADS` allows (1 for a
+//!   one-thread comparison).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -291,6 +294,15 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
         indices
     };
     let overdraw_acmr = (ours_acmr("sander07:cache=16,lambda=0.85"), theirs_acmr(overdraw_theirs()));
+    // Our own overdraw ordering (issue 19) against the same peer, its adjacency given.
+    let cheap_cuts = order::resolve("cheap-cuts", 0).expect("a registered method");
+    let cheap_acmr = (ours_acmr("cheap-cuts"), overdraw_acmr.1);
+    let [cheap_theirs, cheap_ours] = interleaved(
+        reps,
+        [&mut || drop(black_box(overdraw_theirs())), &mut || {
+            drop(black_box(cheap_cuts.ordering.order(black_box(scene))))
+        }],
+    );
     let [overdraw_theirs, sander_ours, sander_with_adjacency] = interleaved(
         reps,
         [
@@ -307,6 +319,7 @@ pub fn compare_orderings(scene: &Scene, reps: usize) -> Vec<BenchRow> {
         row("  the same, + adjacency", [&vcache_theirs, &forsyth_with_adjacency], vcache_acmr),
         row("sander07 vs optimizeVertexCache+Overdraw(1.05)", [&overdraw_theirs, &sander_ours], overdraw_acmr),
         row("  the same, + adjacency", [&overdraw_theirs, &sander_with_adjacency], overdraw_acmr),
+        row("cheap-cuts vs optimizeVertexCache+Overdraw(1.05)", [&cheap_theirs, &cheap_ours], cheap_acmr),
     ]
 }
 
