@@ -79,6 +79,8 @@
 //! label = "metric:iterations"      # bar: write this metric of the same model and method above
 //!                                  # each bar instead of the bar's value
 //! view = [0, 0, 1]                 # sequence, corners: direction the model is seen from
+//! highlight = ["cheap-cuts"]       # line, scatter with methods as series: these methods drawn
+//!                                  # last, with larger outlined markers
 //!
 //! [quick]                          # what `--quick` runs: procedural models and assets/ only,
 //! models = ["assets/spot.obj"]     # done in seconds; caches, views, res and render_frames
