@@ -212,11 +212,11 @@ impl Nodes<'_> {
     }
 }
 
-/// One k-means over the nodes of a run of frames.
 /// Rounds in a row without a new lowest total of passing fragments after which the k-means
 /// stops (module notes, step 6).
 const STALL_ROUNDS: usize = 3;
 
+/// One k-means over the nodes of a run of frames.
 struct KMeans {
     buffers: Vec<Clustered>,
     /// Per node `(frame − first) × views + view`: its cluster.
