@@ -80,7 +80,15 @@
 //!                                  # each bar instead of the bar's value
 //! view = [0, 0, 1]                 # sequence, corners: direction the model is seen from
 //! highlight = ["cheap-cuts"]       # line, scatter with methods as series: these methods drawn
-//!                                  # last, with larger outlined markers
+//!                                  # last, with larger outlined markers; a line chart of more
+//!                                  # than 8 series draws the others as grey context
+//! relative_to = "hoppe"            # table with methods as series: each cell is that method's
+//!                                  # value ÷ the cell's (times lower; higher is better)
+//!
+//! Figures name methods by what tells them apart (`tipsify cache=8`; the full spec is in the
+//! CSV), grow bars from the metric's optimum where it has one (an overdraw ratio's 1), cut a
+//! few far taller bars at the top with their values written, and break lines where nothing was
+//! measured.
 //!
 //! [quick]                          # what `--quick` runs: procedural models and assets/ only,
 //! models = ["assets/spot.obj"]     # done in seconds; caches, views, res and render_frames

@@ -26,6 +26,8 @@ pub struct Frame {
     pub y_desc: String,
     /// Category names at x = 0, 1, 2, … (bar charts): the x axis shows them instead of numbers.
     pub categories: Option<Vec<String>>,
+    /// The metric's best possible value, drawn as a dashed line where it is inside the y range.
+    pub optimum: Option<f64>,
 }
 
 /// Draws one panel's data into its chart, whatever the axes' scales.
@@ -112,7 +114,16 @@ where
         mesh.x_labels(names.len()).x_label_formatter(&category).disable_x_mesh();
     }
     mesh.draw()?;
-    painter.paint(&mut chart)
+    painter.paint(&mut chart)?;
+    let (x, y) = (chart.x_range(), chart.y_range());
+    if let Some(o) = frame.optimum.filter(|o| y.start < *o && *o <= y.end) {
+        let grey = RGBColor(0x33, 0x33, 0x33);
+        chart.draw_series(DashedLineSeries::new([(x.start, o), (x.end, o)], 6, 4, grey.stroke_width(1)))?;
+        let style = TextStyle::from((FONT, 11)).color(&grey).pos(Pos::new(HPos::Right, VPos::Bottom));
+        let text = EmptyElement::at((x.end, o)) + Text::new(format!("optimum {}", number(o)), (-4, -2), style);
+        chart.draw_series(std::iter::once(text))?;
+    }
+    Ok(())
 }
 
 /// Colours chosen so that a series keeps its colour from figure to figure, by its name alone:
@@ -123,7 +134,38 @@ where
 /// where their preferred slots collide, the family first in alphabetical order keeps its slot
 /// and the other takes the next free one. So adding a method to the registry changes no figure
 /// it is not in, and a figure's colours do not depend on its legend order.
-pub struct Colors(Vec<(String, RGBColor)>);
+///
+/// Each series also has a marker shape (its family's slot, shifted per variant), so lines and
+/// points stay apart in greyscale and where two colours are close. In a crowded line chart the
+/// series that are not highlighted can be drawn as grey context ([`Colors::context`]): one
+/// legend entry stands for them all.
+pub struct Colors {
+    entries: Vec<(String, RGBColor)>,
+    markers: Vec<Marker>,
+    /// Series drawn as grey context, not in the legend one by one.
+    context: Vec<String>,
+}
+
+/// A point marker's shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Marker {
+    Circle,
+    Square,
+    Triangle,
+    Diamond,
+    Cross,
+}
+
+const MARKERS: [Marker; 5] = [Marker::Circle, Marker::Square, Marker::Triangle, Marker::Diamond, Marker::Cross];
+
+/// The grey of context series.
+const CONTEXT: RGBColor = RGBColor(0xbb, 0xbb, 0xbb);
+
+/// What a series name is a variant of: a method's name without its parameters (`tipsify` of
+/// `tipsify:cache=8`, or of its display name `tipsify cache=8`).
+pub fn family(name: &str) -> &str {
+    name.split([':', ' ']).next().unwrap_or(name)
+}
 
 /// Methods with a palette slot of their own, in slot order: the file's order and the worst case.
 const RESERVED: [&str; 2] = ["input", "random"];
@@ -140,7 +182,7 @@ const PALETTE: [RGBColor; 28] = [
     RGBColor(0xed, 0xc9, 0x48), // yellow
     RGBColor(0xff, 0x9d, 0xa7), // pink
     RGBColor(0x17, 0xbe, 0xcf), // cyan
-    RGBColor(0x11, 0x11, 0x11), // black
+    RGBColor(0xbc, 0xbd, 0x22), // yellow-green
     RGBColor(0x7f, 0x3c, 0x8d), // dark purple
     RGBColor(0x1b, 0x6e, 0x3b), // dark green
     RGBColor(0x1f, 0x3a, 0x93), // navy
@@ -155,7 +197,7 @@ const PALETTE: [RGBColor; 28] = [
     RGBColor(0xd2, 0xb4, 0x8c), // tan
     RGBColor(0x80, 0x00, 0x00), // maroon
     RGBColor(0x70, 0x80, 0x90), // slate
-    RGBColor(0x2f, 0x4f, 0x4f), // dark slate
+    RGBColor(0x8d, 0xd3, 0xc7), // mint
     RGBColor(0xc7, 0x15, 0x85), // violet red
 ];
 
@@ -163,7 +205,7 @@ impl Colors {
     /// Colours for the series `names` (in legend order) of the CSV column `column`.
     pub fn new(column: &str, names: &[String]) -> Colors {
         let methods = column == "method" || column == "method_name";
-        let family = |name: &str| if methods { name.split(':').next().unwrap_or(name) } else { name }.to_string();
+        let family = |name: &str| if methods { family(name) } else { name }.to_string();
         let mut families: Vec<String> = names.iter().map(|n| family(n)).collect();
         families.sort();
         families.dedup();
@@ -178,7 +220,7 @@ impl Colors {
             }
             slots.push((key.clone(), slot));
         }
-        let colors = names
+        let (entries, markers) = names
             .iter()
             .map(|name| {
                 let key = family(name);
@@ -187,19 +229,76 @@ impl Colors {
                 variants.sort_by_key(|n| natural(n));
                 variants.dedup();
                 let k = variants.iter().position(|n| *n == name).unwrap_or(0);
-                (name.clone(), shade(PALETTE[slot], k, variants.len()))
+                ((name.clone(), shade(PALETTE[slot], k, variants.len())), MARKERS[(slot + k) % MARKERS.len()])
             })
-            .collect();
-        Colors(colors)
+            .unzip();
+        Colors { entries, markers, context: Vec::new() }
+    }
+
+    /// The same colours, with `names` drawn as grey context and listed as one legend entry.
+    pub fn context(mut self, names: Vec<String>) -> Colors {
+        self.context = names;
+        self
     }
 
     pub fn of(&self, name: &str) -> RGBColor {
-        self.0.iter().find(|(n, _)| n == name).map_or(BLACK, |&(_, c)| c)
+        if self.is_context(name) {
+            return CONTEXT;
+        }
+        self.entries.iter().find(|(n, _)| n == name).map_or(BLACK, |&(_, c)| c)
     }
 
-    pub fn entries(&self) -> &[(String, RGBColor)] {
-        &self.0
+    pub fn marker(&self, name: &str) -> Marker {
+        self.entries.iter().position(|(n, _)| n == name).map_or(Marker::Circle, |i| self.markers[i])
     }
+
+    pub fn is_context(&self, name: &str) -> bool {
+        self.context.iter().any(|c| c == name)
+    }
+
+    /// The legend's entries: every series not drawn as context, then one for the context.
+    fn legend_entries(&self) -> Vec<(String, RGBColor, Option<Marker>)> {
+        let mut entries: Vec<_> = self
+            .entries
+            .iter()
+            .zip(&self.markers)
+            .filter(|((n, _), _)| !self.is_context(n))
+            .map(|((n, c), m)| (n.clone(), *c, Some(*m)))
+            .collect();
+        if !self.context.is_empty() {
+            let label = format!("{} other orderings (grey; each named in the CSV)", self.context.len());
+            entries.push((label, CONTEXT, None));
+        }
+        entries
+    }
+}
+
+/// Draws `size`-pixel markers of `shape` at `points`.
+pub fn markers<'a, 'b: 'a, X, Y>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    points: &[(f64, f64)],
+    shape: Marker,
+    size: i32,
+    style: ShapeStyle,
+) -> DrawResult
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let at = |p: &(f64, f64)| EmptyElement::at(*p);
+    let s = size;
+    match shape {
+        Marker::Circle => chart.draw_series(points.iter().map(|p| Circle::new(*p, s, style)))?,
+        Marker::Square => {
+            chart.draw_series(points.iter().map(|p| at(p) + Rectangle::new([(-s, -s), (s, s)], style)))?
+        }
+        Marker::Triangle => chart.draw_series(points.iter().map(|p| TriangleMarker::new(*p, s + 1, style)))?,
+        Marker::Diamond => chart.draw_series(
+            points.iter().map(|p| at(p) + Polygon::new(vec![(0, -s - 1), (s + 1, 0), (0, s + 1), (-s - 1, 0)], style)),
+        )?,
+        Marker::Cross => chart.draw_series(points.iter().map(|p| Cross::new(*p, s, style.stroke_width(2))))?,
+    };
+    Ok(())
 }
 
 /// `text` as runs of letters and numbers, numbers compared by value: `cache=8` before `cache=16`.
@@ -257,11 +356,11 @@ pub fn text_width(text: &str, size: f64) -> i32 {
 
 /// Where each legend entry goes in a strip `width` wide: `(x, row)`, entries flowing left to
 /// right and wrapping.
-fn legend_layout(entries: &[(String, RGBColor)], width: i32) -> Vec<(i32, i32)> {
+fn legend_layout(entries: &[(String, RGBColor, Option<Marker>)], width: i32) -> Vec<(i32, i32)> {
     let (mut x, mut row) = (20, 0);
     entries
         .iter()
-        .map(|(label, _)| {
+        .map(|(label, _, _)| {
             let w = 34 + text_width(label, LEGEND_FONT) + 24;
             if x > 20 && x + w > width - 20 {
                 x = 20;
@@ -274,22 +373,43 @@ fn legend_layout(entries: &[(String, RGBColor)], width: i32) -> Vec<(i32, i32)> 
         .collect()
 }
 
-/// Height of the legend strip for `entries` in `width` pixels.
-pub fn legend_height(entries: &[(String, RGBColor)], width: u32) -> u32 {
-    let rows = legend_layout(entries, width as i32).last().map_or(0, |&(_, r)| r + 1);
+/// Height of the legend strip for `colors` in `width` pixels.
+pub fn legend_height(colors: &Colors, width: u32) -> u32 {
+    let rows = legend_layout(&colors.legend_entries(), width as i32).last().map_or(0, |&(_, r)| r + 1);
     (rows * LEGEND_ROW + 12) as u32
 }
 
-/// Draws the legend strip: a swatch and the series name per entry.
-pub fn legend(area: &Area, entries: &[(String, RGBColor)], swatch: Swatch) -> DrawResult {
+/// Draws the legend strip: a swatch (with the series' marker for lines and points) and the
+/// series name per entry.
+pub fn legend(area: &Area, colors: &Colors, swatch: Swatch) -> DrawResult {
     let width = area.dim_in_pixel().0 as i32;
     let style = TextStyle::from((FONT, LEGEND_FONT)).pos(Pos::new(HPos::Left, VPos::Center));
-    for ((label, color), (x, row)) in entries.iter().zip(legend_layout(entries, width)) {
+    let entries = colors.legend_entries();
+    for ((label, color, marker), (x, row)) in entries.iter().zip(legend_layout(&entries, width)) {
         let y = 6 + row * LEGEND_ROW + LEGEND_ROW / 2;
-        match swatch {
-            Swatch::Line => area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], color.stroke_width(3)))?,
-            Swatch::Point => area.draw(&Circle::new((x + 13, y), 5, color.filled()))?,
-            Swatch::Block => area.draw(&Rectangle::new([(x + 4, y - 7), (x + 22, y + 7)], color.filled()))?,
+        let (mx, s) = (x + 13, 4);
+        let shape = |area: &Area, marker: Marker, style: ShapeStyle| -> DrawResult {
+            match marker {
+                Marker::Circle => area.draw(&Circle::new((mx, y), s + 1, style)),
+                Marker::Square => area.draw(&Rectangle::new([(mx - s, y - s), (mx + s, y + s)], style)),
+                Marker::Triangle => area.draw(&TriangleMarker::new((mx, y), s + 1, style)),
+                Marker::Diamond => area.draw(&Polygon::new(
+                    vec![(mx, y - s - 1), (mx + s + 1, y), (mx, y + s + 1), (mx - s - 1, y)],
+                    style,
+                )),
+                Marker::Cross => area.draw(&Cross::new((mx, y), s, style.stroke_width(2))),
+            }
+        };
+        match (swatch, marker) {
+            (Swatch::Line, _) => {
+                area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], color.stroke_width(3)))?;
+                if let Some(m) = marker {
+                    shape(area, *m, color.filled())?;
+                }
+            }
+            (Swatch::Point, Some(m)) => shape(area, *m, color.filled())?,
+            (Swatch::Point, None) => area.draw(&Circle::new((mx, y), 5, color.filled()))?,
+            (Swatch::Block, _) => area.draw(&Rectangle::new([(x + 4, y - 7), (x + 22, y + 7)], color.filled()))?,
         }
         area.draw(&Text::new(label.clone(), (x + 34, y), style.clone()))?;
     }

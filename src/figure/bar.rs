@@ -69,12 +69,24 @@ impl Kind for Bars {
             Some(i) => &self.values[i..=i],
             None => &self.values[..],
         };
-        let all = panels.iter().flatten().flatten().flatten().copied();
+        let all: Vec<f64> = panels.iter().flatten().flatten().flatten().copied().collect();
         Extent {
             x: XAxis::Categories(self.categories.clone()),
-            y: super::span(all).unwrap_or((0.0, 1.0)),
+            y: super::span(all.iter().copied()).unwrap_or((0.0, 1.0)),
             from_zero: true,
+            bars: all,
         }
+    }
+
+    /// Wide enough that no two category labels overlap: a label never gets cut or drawn over
+    /// its neighbour, the panel grows instead.
+    fn min_panel_width(&self) -> usize {
+        let widest = self.categories.iter().map(|c| axes::text_width(c, 12.0)).max().unwrap_or(0);
+        let shown = (0..self.values.len())
+            .map(|p| (0..self.categories.len()).filter(|&i| self.values[p].iter().any(|s| s[i].is_some())).count())
+            .max()
+            .unwrap_or(0);
+        shown * (widest as usize + 14) + 110
     }
 
     fn swatch(&self) -> Swatch {
@@ -130,23 +142,46 @@ impl Painter for BarPainter<'_> {
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let width = GROUP_WIDTH / self.bars.series.len() as f64;
-        let base = self.base.max(0.0).max(chart.y_range().start);
+        // A panel whose categories each have one bar (the series are the categories) draws it
+        // across the whole slot, not in a sliver of it.
+        let categories = self.values.first().map_or(0, Vec::len);
+        let single = (0..categories).all(|i| self.values.iter().filter(|s| s[i].is_some()).count() <= 1);
+        let width = if single { GROUP_WIDTH } else { GROUP_WIDTH / self.bars.series.len() as f64 };
+        let y_range = chart.y_range();
+        let base = self.base.max(0.0).max(y_range.start);
         let pixels = chart.backend_coord(&(width, base)).0 - chart.backend_coord(&(0.0, base)).0;
         let label = TextStyle::from((FONT, 11)).pos(Pos::new(HPos::Center, VPos::Bottom));
+        let clipped = TextStyle::from((FONT, 11).into_font().style(FontStyle::Bold))
+            .color(&WHITE)
+            .pos(Pos::new(HPos::Center, VPos::Top));
         for (j, ((name, values), labels)) in self.bars.series.iter().zip(self.values).zip(self.labels).enumerate() {
             let color = self.colors.of(name);
             for (i, value) in values.iter().enumerate() {
                 let Some(y) = *value else { continue };
-                let left = i as f64 - GROUP_WIDTH / 2.0 + j as f64 * width;
+                let left = i as f64 - GROUP_WIDTH / 2.0 + if single { 0.0 } else { j as f64 * width };
+                let text = match labels[i].parse::<f64>() {
+                    Ok(v) => axes::number(v),
+                    Err(_) if labels[i].is_empty() => axes::number(y),
+                    Err(_) => labels[i].clone(),
+                };
+                if y > y_range.end {
+                    // Beyond the axis (an outlier such as random's ACMR 3 among 0.6–0.9): drawn to
+                    // the top, cut by a white break, its value written inside.
+                    let top = y_range.end;
+                    let cut = top - (top - base) * 0.06;
+                    let rect =
+                        |lo: f64, hi: f64, style: ShapeStyle| Rectangle::new([(left, lo), (left + width, hi)], style);
+                    chart.draw_series([
+                        rect(base, top, color.filled()),
+                        rect(cut, cut + (top - base) * 0.015, WHITE.filled()),
+                    ])?;
+                    let inside = EmptyElement::at((left + width / 2.0, cut)) + Text::new(text, (0, 4), clipped.clone());
+                    chart.draw_series(std::iter::once(inside))?;
+                    continue;
+                }
                 chart
                     .draw_series(std::iter::once(Rectangle::new([(left, base), (left + width, y)], color.filled())))?;
                 if pixels >= MIN_LABELLED_BAR {
-                    let text = match labels[i].parse::<f64>() {
-                        Ok(v) => axes::number(v),
-                        Err(_) if labels[i].is_empty() => axes::number(y),
-                        Err(_) => labels[i].clone(),
-                    };
                     let top = EmptyElement::at((left + width / 2.0, y)) + Text::new(text, (0, -3), label.clone());
                     chart.draw_series(std::iter::once(top))?;
                 }

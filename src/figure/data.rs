@@ -185,6 +185,10 @@ impl Table {
             .collect::<Result<Vec<_>>>()?;
         let triangles =
             (figure.facet.as_deref() == Some("model")).then(|| self.column("model_triangles").ok()).flatten();
+        // A table's rows of models say what each model is, as the papers' tables do.
+        let counts = (figure.kind == FigureKind::Table && figure.x.as_deref() == Some("model"))
+            .then(|| Some((self.column("model_vertices").ok()?, self.column("model_triangles").ok()?)))
+            .flatten();
 
         let mut panels: Vec<Panel> = Vec::new();
         for (i, record) in self.records.iter().enumerate() {
@@ -197,7 +201,10 @@ impl Table {
             let y: f64 = record[value].parse().map_err(|_| {
                 Error::input(self.path.display(), format!("line {line}: value `{}` is not a number", &record[value]))
             })?;
-            let x = x.as_ref().map_or(String::new(), |c| c.cell(record));
+            let mut x = x.as_ref().map_or(String::new(), |c| c.cell(record));
+            if let Some((v, t)) = counts {
+                x = format!("{x} ({} vertices, {} triangles)", thousands(&record[v]), thousands(&record[t]));
+            }
             if x.is_empty() && figure.x.as_deref().is_some_and(|c| c.contains(':')) {
                 continue; // a method without that parameter, a static model, or not measured by the x metric
             }
@@ -236,6 +243,7 @@ impl Table {
             series.points.push((x, y));
             series.labels.push(label.as_ref().map_or(String::new(), |l| l.cell(record)));
         }
+        shorten_methods(figure, &mut panels);
         if panels.is_empty() {
             let mut metrics: Vec<&str> = self.records.iter().map(|r| &r[metric]).collect();
             metrics.sort_unstable();
@@ -298,6 +306,68 @@ impl Column {
     }
 }
 
+/// Writes the method specs a figure shows (as series, x categories or panel titles) as their
+/// [`display_names`], each set named together so two variants of one method stay apart.
+fn shorten_methods(figure: &Figure, panels: &mut [Panel]) {
+    fn rename(names: &mut [&mut String]) {
+        let mut specs: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+        specs.sort();
+        specs.dedup();
+        let short = display_names(&specs);
+        for name in names {
+            if let Ok(i) = specs.binary_search(name) {
+                **name = short[i].clone();
+            }
+        }
+    }
+    if figure.series == "method" {
+        rename(&mut panels.iter_mut().flat_map(|p| p.series.iter_mut().map(|s| &mut s.name)).collect::<Vec<_>>());
+    }
+    if figure.x.as_deref() == Some("method") {
+        let mut xs: Vec<&mut String> = panels
+            .iter_mut()
+            .flat_map(|p| p.series.iter_mut().flat_map(|s| s.points.iter_mut().map(|(x, _)| x)))
+            .collect();
+        rename(&mut xs);
+    }
+    if figure.facet.as_deref() == Some("method") {
+        rename(&mut panels.iter_mut().map(|p| &mut p.title).collect::<Vec<_>>());
+    }
+}
+
+/// How a figure names canonical method specs (`tipsify:cache=16,lambda=...`): the method's
+/// name, then only the parameters whose values differ between the specs of that method in
+/// `specs` (`tipsify cache=8`, `tipsify cache=16`). A method that appears once is its bare
+/// name. The full spec stays in the CSV; a legend or tick label shows what tells series apart.
+pub fn display_names(specs: &[String]) -> Vec<String> {
+    let split = |spec: &str| -> (String, Vec<(String, String)>) {
+        let (name, params) = spec.split_once(':').unwrap_or((spec, ""));
+        let params = params
+            .split(',')
+            .filter(|kv| !kv.is_empty())
+            .map(|kv| {
+                let (k, v) = kv.split_once('=').unwrap_or((kv, ""));
+                (k.to_string(), v.to_string())
+            })
+            .collect();
+        (name.to_string(), params)
+    };
+    let parsed: Vec<_> = specs.iter().map(|s| split(s)).collect();
+    parsed
+        .iter()
+        .map(|(name, params)| {
+            let same_method: Vec<&Vec<(String, String)>> =
+                parsed.iter().filter(|(n, _)| n == name).map(|(_, p)| p).collect();
+            let differs = |key: &str, value: &str| {
+                same_method.iter().any(|other| other.iter().find(|(k, _)| k == key).is_none_or(|(_, v)| v != value))
+            };
+            let shown: Vec<String> =
+                params.iter().filter(|(k, v)| differs(k, v)).map(|(k, v)| format!("{k}={v}")).collect();
+            if shown.is_empty() { name.clone() } else { format!("{name} {}", shown.join(" ")) }
+        })
+        .collect()
+}
+
 /// The value of parameter `name` in a canonical method spec `method:k=v,k=v`.
 pub fn parameter<'a>(spec: &'a str, name: &str) -> Option<&'a str> {
     let (_, params) = spec.split_once(':')?;
@@ -322,6 +392,16 @@ fn thousands(digits: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn method_specs_are_shown_by_what_tells_them_apart() {
+        let specs: Vec<String> =
+            ["random:seed=0", "tipsify:cache=8,lambda=1", "tipsify:cache=16,lambda=1", "hoppe:cache=16"]
+                .map(String::from)
+                .to_vec();
+        assert_eq!(display_names(&specs), ["random", "tipsify cache=8", "tipsify cache=16", "hoppe"]);
+        assert_eq!(display_names(&["nehab".to_string()]), ["nehab"]);
+    }
 
     #[test]
     fn source_keys_read_the_animation_with_defaults() {

@@ -57,7 +57,12 @@ impl Kind for Distribution {
             None => &self.panels[..],
         };
         let all = panels.iter().flatten().flat_map(|s| s.values.iter().copied());
-        Extent { x: XAxis::Fixed(0.0..100.0), y: super::span(all).unwrap_or((0.0, 1.0)), from_zero: false }
+        Extent {
+            x: XAxis::Fixed(0.0..100.0),
+            y: super::span(all).unwrap_or((0.0, 1.0)),
+            from_zero: false,
+            bars: Vec::new(),
+        }
     }
 
     fn swatch(&self) -> Swatch {

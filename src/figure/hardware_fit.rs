@@ -121,7 +121,7 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
         }
     }
     let colors = Colors::new("method_name", &names);
-    let legend_h = axes::legend_height(colors.entries(), width);
+    let legend_h = axes::legend_height(&colors, width);
     let mut svg = String::new();
     let drawn = (|| -> DrawResult {
         let root = SVGBackend::with_string(&mut svg, (width, header.height + body + legend_h)).into_drawing_area();
@@ -132,7 +132,7 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
         let (left, right) = middle.split_horizontally(560);
         ranking(&left, &fits)?;
         scatter(&right, best, &colors)?;
-        axes::legend(&legend, colors.entries(), axes::Swatch::Point)
+        axes::legend(&legend, &colors, axes::Swatch::Point)
     })();
     drawn.map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
     save(&path, &svg)?;
@@ -188,6 +188,7 @@ fn scatter(area: &Area, fit: &Fit, colors: &Colors) -> DrawResult {
         x_desc: format!("simulated ACMR, {}", fit.cache),
         y_desc: "vertex-shader invocations per triangle, counted".into(),
         categories: None,
+        optimum: None,
     };
     let title = format!("best fit: {} (RMSE {:.4}); grey: y = x; black: least squares", fit.cache, fit.rmse);
     axes::panel(area, &title, &frame, &FitPainter { fit, colors })

@@ -100,12 +100,16 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
             Box::new(distribution::Distribution::new(&panels))
         }
         FigureKind::Table => {
-            panels = table.select(figure)?;
+            panels = match &figure.relative_to {
+                Some(reference) => relative_to(table.select(figure)?, reference),
+                None => table.select(figure)?,
+            };
             // Methods are what a table compares: when they are the rows, the best is marked
             // down each column; so too when the columns are different metrics.
             let best_per_column =
                 figure.series == "metric" || matches!(figure.x.as_deref(), Some("method" | "method_name"));
-            Box::new(table::Tables { bars: bar::Bars::new(&panels), best_per_column })
+            let higher_better = figure.relative_to.is_some();
+            Box::new(table::Tables { bars: bar::Bars::new(&panels), best_per_column, higher_better })
         }
         FigureKind::Sequence
         | FigureKind::Corners
@@ -130,7 +134,13 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
             names.push(s.name.clone());
         }
     }
-    let colors = Colors::new(&figure.series, &names);
+    let mut colors = Colors::new(&figure.series, &names);
+    if figure.kind == FigureKind::Line && !figure.highlight.is_empty() && names.len() > MAX_COLOURED_LINES {
+        // More lines than a reader can tell apart: the highlighted ones in colour, the rest as
+        // grey context (the paper's series against every other ordering).
+        let context = names.iter().filter(|n| !figure.highlight.iter().any(|h| axes::family(n) == h)).cloned();
+        colors = colors.context(context.collect());
+    }
 
     let path = chart.svg.clone();
     let mut svg = String::new();
@@ -138,6 +148,23 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         .map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
     save(&path, &svg)?;
     Ok(path)
+}
+
+/// Every value of `panels` as the value of the series of method `reference` at the same x,
+/// divided by it: how many times lower than the reference each is (the reference itself is 1).
+/// Points without a reference value at their x are dropped.
+fn relative_to(mut panels: Vec<Panel>, reference: &str) -> Vec<Panel> {
+    for panel in &mut panels {
+        let Some(base) = panel.series.iter().find(|s| axes::family(&s.name) == reference).cloned() else { continue };
+        for series in &mut panel.series {
+            series.points.retain_mut(|(x, v)| {
+                let Some((_, r)) = base.points.iter().find(|(bx, _)| bx == x) else { return false };
+                *v = r / *v;
+                v.is_finite()
+            });
+        }
+    }
+    panels
 }
 
 /// "measured on DEVICE" for the GPUs that counted or timed rows of `table` (their `backend` is
@@ -194,6 +221,10 @@ trait Kind {
     fn panel_size(&self) -> Option<(usize, usize)> {
         None
     }
+    /// The narrowest a panel may be (bars: room for their category labels).
+    fn min_panel_width(&self) -> usize {
+        0
+    }
     /// Draws panel `index` into `area`.
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult;
 }
@@ -203,8 +234,10 @@ struct Extent {
     x: XAxis,
     /// Smallest and largest y.
     y: (f64, f64),
-    /// Bars: a linear y axis starts at zero.
+    /// Bars: a linear y axis starts at zero (or at the metric's optimum).
     from_zero: bool,
+    /// Bars: every value drawn, to find outliers that would flatten the rest.
+    bars: Vec<f64>,
 }
 
 enum XAxis {
@@ -243,12 +276,19 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &st
         XAxis::Categories(names) => (-0.5..names.len() as f64 - 0.5, Some(names)),
     };
     let (lo, hi) = extent.y;
+    // The metric's optimum, when every metric drawn shares one: marked, and where bars grow from.
+    let optimums: Vec<Option<f64>> = figure.metrics.iter().map(|m| measure::optimum(m)).collect();
+    let optimum = optimums.first().copied().flatten().filter(|o| optimums.iter().all(|p| *p == Some(*o)));
     let y = match figure.y_range {
         Some((lo, hi)) => lo..hi,
         None if figure.y_log && lo <= 0.0 => return Err(log_error("y_log", lo)),
         None if extent.from_zero && !figure.y_log => {
-            let padded = pad(lo.min(0.0), hi.max(0.0), false);
-            (if lo >= 0.0 { 0.0 } else { padded.start })..(if hi <= 0.0 { 0.0 } else { padded.end })
+            // Bars grow from the optimum when nothing lies below it (an overdraw ratio's 1), so
+            // their heights are the excess over it; else from zero.
+            let base = optimum.filter(|&o| lo >= o).unwrap_or(0.0);
+            let hi = below_outliers(&extent.bars, base).unwrap_or(hi);
+            let padded = pad(lo.min(base), hi.max(base), false);
+            (if lo >= base { base } else { padded.start })..(if hi <= base { base } else { padded.end })
         }
         None => pad(lo, hi, figure.y_log),
     };
@@ -260,18 +300,36 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &st
         (None, None) if figure.metric == "ovr" => "views, sorted by overdraw ratio (percentile)".to_string(),
         (None, None) => "values, sorted (percentile)".to_string(),
     };
-    Ok(Frame {
-        x,
-        y,
-        x_log: figure.x_log,
-        y_log: figure.y_log,
-        x_desc,
-        y_desc: match panel {
-            Some((_, title)) => title.to_string(),
-            None => figure.y_label.clone().unwrap_or(metric),
-        },
-        categories,
-    })
+    let mut y_desc = match panel {
+        Some((_, title)) => title.to_string(),
+        None => figure.y_label.clone().unwrap_or(metric),
+    };
+    if let Some(o) = optimum.filter(|&o| o == y.start) {
+        // Bars growing from the optimum: it is the axis itself, so it is named, not drawn.
+        y_desc = format!("{y_desc} (bars from the optimum, {})", axes::number(o));
+    }
+    Ok(Frame { x, y, x_log: figure.x_log, y_log: figure.y_log, x_desc, y_desc, categories, optimum })
+}
+
+/// Fewest bars among which one can be called an outlier: with two or three, a tall bar is the
+/// comparison itself.
+const MIN_BARS_FOR_OUTLIERS: usize = 8;
+
+/// The top of the bars above `base` once a few far taller ones are left out: a bar more than
+/// four times the median height, when at most a quarter of the bars are, is an outlier (random's
+/// ACMR 3 beside orderings at 0.6–0.9) that would leave the differences the figure is about a
+/// sliver of the height. The outliers are then drawn cut at the top with their values written
+/// (`bar`). `None` when there is no outlier.
+fn below_outliers(values: &[f64], base: f64) -> Option<f64> {
+    let mut heights: Vec<f64> = values.iter().map(|v| v - base).filter(|h| *h >= 0.0).collect();
+    heights.sort_by(f64::total_cmp);
+    let median = *heights.get(heights.len() / 2)?;
+    let limit = 4.0 * median;
+    let outliers = heights.iter().filter(|&&h| h > limit).count();
+    if median <= 0.0 || outliers == 0 || outliers * 4 > heights.len() || heights.len() < MIN_BARS_FOR_OUTLIERS {
+        return None;
+    }
+    heights.iter().rev().find(|&&h| h <= limit).map(|h| h + base)
 }
 
 /// `lo..hi` widened by 5% of the span each side (a ratio on log axes); a single value gets a
@@ -294,9 +352,14 @@ fn column_label(column: &str) -> &str {
         "seconds" => "ordering time (s)",
         "res" => "image size (pixels per side)",
         "view" => "view (index in the set)",
+        "method" | "method_name" => "ordering",
         other => other,
     }
 }
+
+/// Most lines drawn each in its own colour when a figure highlights some: past it the others
+/// are grey context. Eight is about what distinct hues and markers keep apart.
+const MAX_COLOURED_LINES: usize = 8;
 
 /// Widest panel that is drawn beside another.
 const MAX_SIDE_BY_SIDE_W: usize = 1000;
@@ -314,17 +377,19 @@ fn draw(
     let n = panels.len();
     // Panels wider than a screen's half (tables with many columns) stack, so the figure stays
     // readable at page width.
-    let cols = match (n, kind.panel_size()) {
+    let (panel_w, panel_h) = kind.panel_size().unwrap_or(if n == 1 { (760, 500) } else { (540, 400) });
+    let panel_w = panel_w.max(kind.min_panel_width());
+    let cols = match (n, panel_w) {
         (1, _) => 1,
-        (_, Some((w, _))) if w > MAX_SIDE_BY_SIDE_W => 1,
+        (_, w) if w > MAX_SIDE_BY_SIDE_W => 1,
         (2 | 4, _) => 2,
+        (_, w) if w > MAX_SIDE_BY_SIDE_W / 2 + 100 => 2,
         _ => 3,
     };
     let rows = n.div_ceil(cols);
-    let (panel_w, panel_h) = kind.panel_size().unwrap_or(if n == 1 { (760, 500) } else { (540, 400) });
     let width = (cols * panel_w) as u32;
     let header = Header::new(chart, setup, width);
-    let legend_h = if kind.legend() { axes::legend_height(colors.entries(), width) } else { 0 };
+    let legend_h = if kind.legend() { axes::legend_height(colors, width) } else { 0 };
     let height = header.height + (rows * panel_h) as u32 + legend_h;
 
     let root = SVGBackend::with_string(svg, (width, height)).into_drawing_area();
@@ -336,7 +401,7 @@ fn draw(
         kind.draw(i, area, &panel.title, &frames[i.min(frames.len() - 1)], colors)?;
     }
     if kind.legend() {
-        axes::legend(&legend, colors.entries(), kind.swatch())?;
+        axes::legend(&legend, colors, kind.swatch())?;
     }
     root.present()
 }

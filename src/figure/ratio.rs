@@ -100,12 +100,13 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
         x_desc: figure.x_label.clone().unwrap_or_else(|| format!("{x_metric}: {a} ÷ {b}")),
         y_desc: figure.y_label.clone().unwrap_or_else(|| format!("{}: {a} ÷ {b}", figure.metric)),
         categories: None,
+        optimum: None,
     };
     let names: Vec<String> = points.iter().map(|(s, _)| s.clone()).collect();
     let colors = Colors::new(&figure.series, &names);
     let width = 760;
     let header = Header::new(chart, &setup, width);
-    let legend_h = axes::legend_height(colors.entries(), width);
+    let legend_h = axes::legend_height(&colors, width);
     let path = chart.svg.clone();
     let mut svg = String::new();
     let drawn = (|| -> DrawResult {
@@ -115,7 +116,7 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<PathBuf> {
         let (body, legend): (Area, Area) = rest.split_vertically(560);
         header.draw(&top)?;
         axes::panel(&body, "grey lines: equal (ratio 1)", &frame, &RatioPainter { points: &points, colors: &colors })?;
-        axes::legend(&legend, colors.entries(), axes::Swatch::Point)
+        axes::legend(&legend, &colors, axes::Swatch::Point)
     })();
     drawn.map_err(|e| Error::output(&path, format!("cannot draw the figure: {e}")))?;
     save(&path, &svg)?;

@@ -67,6 +67,9 @@ pub struct Figure {
     /// Line and scatter charts of methods: the method names drawn on top with larger, outlined
     /// markers (a new method and its peers among every ordering, issue 19).
     pub highlight: Vec<String>,
+    /// Tables of methods: each cell shows this method's value ÷ the cell's (how many times lower
+    /// than the reference, the form of Nehab et al.'s "variance drops 50×"); higher is better.
+    pub relative_to: Option<String>,
 }
 
 /// The chart kinds `triorder plot` draws.
@@ -158,6 +161,7 @@ pub struct RawFigure {
     ratio: Option<[String; 2]>,
     #[serde(default)]
     highlight: Vec<String>,
+    relative_to: Option<String>,
 }
 
 /// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
@@ -333,6 +337,14 @@ impl RawFigure {
                 return Err(format!("figure.highlight names `{missing}`, which is not a method of this spec"));
             }
         }
+        if let Some(reference) = &self.relative_to {
+            if self.kind != FigureKind::Table || !matches!(series.as_str(), "method" | "method_name") {
+                return Err("figure.relative_to is for tables whose series are methods (series = \"method\")".into());
+            }
+            if !methods.iter().any(|m| m.split(':').next() == Some(reference.as_str())) {
+                return Err(format!("figure.relative_to names `{reference}`, which is not a method of this spec"));
+            }
+        }
         let y_range = match self.y_range {
             Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
                 return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
@@ -359,6 +371,7 @@ impl RawFigure {
             view,
             ratio,
             highlight: self.highlight,
+            relative_to: self.relative_to,
         })
     }
 }

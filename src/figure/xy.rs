@@ -72,7 +72,7 @@ impl Kind for Xy {
         let (x, y) = super::span(self.points(panel).map(|p| p.0))
             .zip(super::span(self.points(panel).map(|p| p.1)))
             .unwrap_or(((0.0, 1.0), (0.0, 1.0)));
-        Extent { x: XAxis::Data(x.0, x.1), y, from_zero: false }
+        Extent { x: XAxis::Data(x.0, x.1), y, from_zero: false, bars: Vec::new() }
     }
 
     fn swatch(&self) -> Swatch {
@@ -80,7 +80,13 @@ impl Kind for Xy {
     }
 
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult {
-        let painter = XyPainter { series: &self.panels[index], colors, lines: self.lines, highlight: &self.highlight };
+        let painter = XyPainter {
+            series: &self.panels[index],
+            colors,
+            lines: self.lines,
+            highlight: &self.highlight,
+            x_log: frame.x_log,
+        };
         axes::panel(area, title, frame, &painter)
     }
 }
@@ -90,6 +96,45 @@ struct XyPainter<'a> {
     colors: &'a Colors,
     lines: bool,
     highlight: &'a [String],
+    x_log: bool,
+}
+
+fn draw_runs<'a, 'b: 'a, X, Y>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    runs: &[&[(f64, f64)]],
+    style: ShapeStyle,
+) -> DrawResult
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    for run in runs {
+        chart.draw_series(LineSeries::new(run.iter().copied(), style))?;
+    }
+    Ok(())
+}
+
+/// A line's points cut into runs at the gaps where nothing was measured: a step along x (on the
+/// axis' scale) more than three times the series' median step, as from FIFO 64 to FIFO 1024 in a
+/// sweep of 1–64. A straight line across such a gap would show values never measured.
+fn measured_runs(points: &[(f64, f64)], x_log: bool) -> Vec<&[(f64, f64)]> {
+    let at = |x: f64| if x_log { x.log10() } else { x };
+    let steps: Vec<f64> = points.windows(2).map(|w| at(w[1].0) - at(w[0].0)).collect();
+    let mut sorted = steps.clone();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2).filter(|_| steps.len() >= 3) else {
+        return vec![points];
+    };
+    let mut runs = Vec::new();
+    let mut start = 0;
+    for (i, step) in steps.iter().enumerate() {
+        if *step > 3.0 * median && median > 0.0 {
+            runs.push(&points[start..=i]);
+            start = i + 1;
+        }
+    }
+    runs.push(&points[start..]);
+    runs
 }
 
 impl Painter for XyPainter<'_> {
@@ -98,26 +143,55 @@ impl Painter for XyPainter<'_> {
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let highlighted = |name: &str| self.highlight.iter().any(|h| name.split(':').next() == Some(h.as_str()));
-        // The others first, so that the highlighted series are never hidden under them.
-        let (on_top, rest): (Vec<&Curve>, Vec<&Curve>) = self.series.iter().partition(|(name, _)| highlighted(name));
-        for (name, points) in rest.into_iter().chain(on_top) {
-            let color = self.colors.of(name);
-            if highlighted(name) {
-                if self.lines {
-                    chart.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(3)))?;
-                }
-                chart.draw_series(points.iter().map(|&p| Circle::new(p, 6, color.filled())))?;
-                chart.draw_series(points.iter().map(|&p| Circle::new(p, 6, BLACK.stroke_width(2))))?;
-            } else if self.lines {
-                chart.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))?;
-                if points.len() <= MAX_MARKED_POINTS {
-                    chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
-                }
+        let highlighted = |name: &str| self.highlight.iter().any(|h| axes::family(name) == h.as_str());
+        // Grey context first, then the others, so that the highlighted series are never hidden.
+        let rank = |name: &str| usize::from(!self.colors.is_context(name)) + usize::from(highlighted(name));
+        let mut order: Vec<&Curve> = self.series.iter().collect();
+        order.sort_by_key(|(name, _)| rank(name));
+        for (name, points) in order {
+            let (color, shape) = (self.colors.of(name), self.colors.marker(name));
+            let runs = if self.lines { measured_runs(points, self.x_log) } else { Vec::new() };
+            // A dense line is marked at a few evenly spaced points, enough to tell its marker,
+            // and at any point alone between gaps, which would otherwise vanish.
+            let step = points.len().div_ceil(MAX_MARKED_POINTS / 2).max(1);
+            let marked: Vec<(f64, f64)> = if points.len() <= MAX_MARKED_POINTS {
+                points.clone()
             } else {
-                chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, color.mix(0.85).filled())))?;
+                let lone = runs.iter().filter(|r| r.len() == 1).map(|r| r[0]);
+                points.iter().step_by(step).copied().chain(lone).collect()
+            };
+            if self.colors.is_context(name) {
+                draw_runs(chart, &runs, color.stroke_width(1))?;
+            } else if highlighted(name) && self.lines {
+                draw_runs(chart, &runs, color.stroke_width(3))?;
+                axes::markers(chart, &marked, shape, 5, color.filled())?;
+                axes::markers(chart, &marked, shape, 5, BLACK.stroke_width(1))?;
+            } else if highlighted(name) {
+                axes::markers(chart, points, shape, 6, color.filled())?;
+                axes::markers(chart, points, shape, 6, BLACK.stroke_width(2))?;
+            } else if self.lines {
+                draw_runs(chart, &runs, color.stroke_width(2))?;
+                axes::markers(chart, &marked, shape, 3, color.filled())?;
+            } else {
+                axes::markers(chart, points, shape, 4, color.mix(0.85).filled())?;
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_break_where_nothing_was_measured() {
+        let sweep: Vec<(f64, f64)> = [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 1024.0].iter().map(|&x| (x, 1.0)).collect();
+        let runs = measured_runs(&sweep, true);
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[1], [(1024.0, 1.0)]);
+        // Evenly measured: one run.
+        assert_eq!(measured_runs(&sweep[..7], true).len(), 1);
+        assert_eq!(measured_runs(&sweep[..7], false).len(), 2); // 32 → 64 is a wide step on a linear axis
     }
 }

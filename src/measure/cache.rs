@@ -342,8 +342,8 @@ pub struct Simulated;
 pub static METRIC: Simulated = Simulated;
 
 static NAMES: &[Name] = &[
-    Name { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: "`caches`" },
-    Name { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: "`caches`" },
+    Name { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: "`caches`", optimum: None },
+    Name { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: "`caches`", optimum: Some(1.0) },
 ];
 
 impl Metric for Simulated {

@@ -12,8 +12,8 @@ pub struct Counted;
 pub static METRIC: Counted = Counted;
 
 static NAMES: &[Name] = &[
-    Name { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: "`caches = [\"gpu\"]`" },
-    Name { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: "`caches = [\"gpu\"]`" },
+    Name { name: "acmr", label: "ACMR (vertex-cache misses per triangle)", needs: "`caches = [\"gpu\"]`", optimum: None },
+    Name { name: "atvr", label: "ATVR (misses per referenced vertex)", needs: "`caches = [\"gpu\"]`", optimum: Some(1.0) },
 ];
 
 impl Metric for Counted {

@@ -39,37 +39,43 @@ pub struct MeshletMetrics;
 pub static METRIC: MeshletMetrics = MeshletMetrics;
 
 static NAMES: &[Name] = &[
-    Name { name: "meshlets", label: "meshlets (scan builder, 64 vertices, 124 triangles)", needs: "`meshlets = true`" },
-    Name { name: "meshlet_vertex_fill", label: "meshlet vertex fill (mean vertices ÷ 64)", needs: "`meshlets = true`" },
+    Name { name: "meshlets", label: "meshlets (scan builder, 64 vertices, 124 triangles)", needs: "`meshlets = true`", optimum: None },
+    Name { name: "meshlet_vertex_fill", label: "meshlet vertex fill (mean vertices ÷ 64)", needs: "`meshlets = true`", optimum: None },
     Name {
         name: "meshlet_triangle_fill",
         label: "meshlet triangle fill (mean triangles ÷ 124)",
         needs: "`meshlets = true`",
+        optimum: None,
     },
     Name {
         name: "meshlet_vertices_per_triangle",
         label: "meshlet vertices per triangle (Σ meshlet vertices ÷ triangles)",
         needs: "`meshlets = true`",
+        optimum: None,
     },
     Name {
         name: "meshlet_cone_culled",
         label: "share of meshlets a normal cone culls (mean over views)",
         needs: "`meshlets = true` and `views`",
+        optimum: None,
     },
     Name {
         name: "meshlets_optimized",
         label: "meshlets (meshoptimizer's optimized builder)",
         needs: "`meshlets = true`",
+        optimum: None,
     },
     Name {
         name: "meshlet_vertices_per_triangle_optimized",
         label: "meshlet vertices per triangle (optimized builder)",
         needs: "`meshlets = true`",
+        optimum: None,
     },
     Name {
         name: "meshlet_cone_culled_optimized",
         label: "share of meshlets a normal cone culls (optimized builder)",
         needs: "`meshlets = true` and `views`",
+        optimum: None,
     },
 ];
 

@@ -52,13 +52,19 @@ pub mod vendor;
 /// What the ordering itself reports, beside the metrics: every row of a run also carries the
 /// ordering's time, and runs that compare methods with several buffers say how many each needs.
 pub static ORDERING: &[Name] = &[
-    Name { name: "seconds", label: "ordering time (s)", needs: "nothing" },
-    Name { name: "buffers", label: "index buffers", needs: "an animation or a method with several buffers" },
-    Name { name: "iterations", label: "optimization iterations", needs: "a method that iterates" },
+    Name { name: "seconds", label: "ordering time (s)", needs: "nothing", optimum: None },
+    Name {
+        name: "buffers",
+        label: "index buffers",
+        needs: "an animation or a method with several buffers",
+        optimum: None,
+    },
+    Name { name: "iterations", label: "optimization iterations", needs: "a method that iterates", optimum: None },
     Name {
         name: "converged",
         label: "converged before the iteration cap (1) or not (0)",
         needs: "a method that iterates",
+        optimum: None,
     },
 ];
 
@@ -72,8 +78,13 @@ pub fn label(name: &str) -> &str {
     names().find(|n| n.name == name).map_or(name, |n| n.label)
 }
 
+/// The optimum of a reported name (see [`Name::optimum`]); `None` if it has none or is unknown.
+pub fn optimum(name: &str) -> Option<f64> {
+    names().find(|n| n.name == name).and_then(|n| n.optimum)
+}
+
 /// A name a metric reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Name {
     /// The CSV `metric` value and `--json` key.
     pub name: &'static str,
@@ -81,6 +92,9 @@ pub struct Name {
     pub label: &'static str,
     /// What a spec or command line must ask for to get it, for error messages.
     pub needs: &'static str,
+    /// The best value it can take, where there is one a reader measures against (an overdraw
+    /// ratio of 1, no blending error): figures mark it, and bars grow from it.
+    pub optimum: Option<f64>,
 }
 
 /// A measurement of one kind: a vertex-cache model, overdraw, a GPU count or timing.

@@ -53,13 +53,13 @@ pub struct Overdraw;
 pub static METRIC: Overdraw = Overdraw;
 
 static NAMES: &[Name] = &[
-    Name { name: "ovr", label: "overdraw ratio (shaded ÷ covered pixels)", needs: "`views`" },
-    Name { name: "ovr_mean", label: "mean overdraw ratio over views", needs: "`views`" },
-    Name { name: "ovr_max", label: "worst-view overdraw ratio", needs: "`views`" },
-    Name { name: "ovr_min", label: "best-view overdraw ratio", needs: "`views`" },
-    Name { name: "ovr_var", label: "variance of the overdraw ratio over views", needs: "`views`" },
-    Name { name: "ovr_sum", label: "overdraw ratio (Σ shaded ÷ Σ covered)", needs: "`views`" },
-    Name { name: "ovr_empty", label: "views that see nothing", needs: "`views`" },
+    Name { name: "ovr", label: "overdraw ratio (shaded ÷ covered pixels)", needs: "`views`", optimum: Some(1.0) },
+    Name { name: "ovr_mean", label: "mean overdraw ratio over views", needs: "`views`", optimum: Some(1.0) },
+    Name { name: "ovr_max", label: "worst-view overdraw ratio", needs: "`views`", optimum: Some(1.0) },
+    Name { name: "ovr_min", label: "best-view overdraw ratio", needs: "`views`", optimum: Some(1.0) },
+    Name { name: "ovr_var", label: "variance of the overdraw ratio over views", needs: "`views`", optimum: None },
+    Name { name: "ovr_sum", label: "overdraw ratio (Σ shaded ÷ Σ covered)", needs: "`views`", optimum: Some(1.0) },
+    Name { name: "ovr_empty", label: "views that see nothing", needs: "`views`", optimum: None },
 ];
 
 impl Metric for Overdraw {

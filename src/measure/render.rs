@@ -15,20 +15,22 @@ const PIXEL: &str = "render = [\"pixel\"] and `views`";
 const VERTEX: &str = "render = [\"vertex\"] and `views`";
 
 static NAMES: &[Name] = &[
-    Name { name: "render_ms_pixel", label: "frame time, pixel-bound shader (ms, mean over views)", needs: PIXEL },
-    Name { name: "render_ms_vertex", label: "frame time, vertex-bound shader (ms, mean over views)", needs: VERTEX },
+    Name { name: "render_ms_pixel", label: "frame time, pixel-bound shader (ms, mean over views)", needs: PIXEL, optimum: None },
+    Name { name: "render_ms_vertex", label: "frame time, vertex-bound shader (ms, mean over views)", needs: VERTEX, optimum: None },
     Name {
         name: "render_spread_pixel",
         label: "frame-time spread p90 − p10, pixel-bound (ms, mean over views)",
         needs: PIXEL,
+        optimum: None,
     },
     Name {
         name: "render_spread_vertex",
         label: "frame-time spread p90 − p10, vertex-bound (ms, mean over views)",
         needs: VERTEX,
+        optimum: None,
     },
-    Name { name: "render_ms_pixel_view", label: "frame time, pixel-bound shader (ms)", needs: PIXEL },
-    Name { name: "render_ms_vertex_view", label: "frame time, vertex-bound shader (ms)", needs: VERTEX },
+    Name { name: "render_ms_pixel_view", label: "frame time, pixel-bound shader (ms)", needs: PIXEL, optimum: None },
+    Name { name: "render_ms_vertex_view", label: "frame time, vertex-bound shader (ms)", needs: VERTEX, optimum: None },
 ];
 
 /// The names of one shader's values: mean, spread, per view.

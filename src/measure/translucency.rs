@@ -148,12 +148,12 @@ pub static METRIC: Translucency = Translucency;
 const NEEDS: &str = "`views` and `translucency`";
 
 static NAMES: &[Name] = &[
-    Name { name: "translucency_wrong_pixels", label: "wrong-pixel share", needs: NEEDS },
-    Name { name: "translucency_rmse", label: "blend colour RMSE", needs: NEEDS },
-    Name { name: "translucency_pairs", label: "inverted pairs/px", needs: NEEDS },
-    Name { name: "translucency_wrong_pixels_view", label: "share of pixels blended visibly wrong, per view", needs: NEEDS },
-    Name { name: "translucency_rmse_view", label: "colour RMSE, per view", needs: NEEDS },
-    Name { name: "translucency_pairs_view", label: "wrongly blended pairs per pixel, per view", needs: NEEDS },
+    Name { name: "translucency_wrong_pixels", label: "wrong-pixel share", needs: NEEDS, optimum: None },
+    Name { name: "translucency_rmse", label: "blend colour RMSE", needs: NEEDS, optimum: None },
+    Name { name: "translucency_pairs", label: "inverted pairs/px", needs: NEEDS, optimum: None },
+    Name { name: "translucency_wrong_pixels_view", label: "share of pixels blended visibly wrong, per view", needs: NEEDS, optimum: None },
+    Name { name: "translucency_rmse_view", label: "colour RMSE, per view", needs: NEEDS, optimum: None },
+    Name { name: "translucency_pairs_view", label: "wrongly blended pairs per pixel, per view", needs: NEEDS, optimum: None },
 ];
 
 impl Metric for Translucency {
