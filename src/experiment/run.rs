@@ -343,7 +343,7 @@ fn drawn_one(
     };
     let overdraw = match spec.figure.kind {
         FigureKind::Overdraw => {
-            let camera = views::drawing_camera(&mesh.positions, spec.figure.view);
+            let camera = views::drawing_camera(&mesh.positions, spec.figure.view, spec.figure.up);
             let shaded = cpu::shaded_per_pixel(&mesh.positions, &triangles, &camera, views::DRAWING_RES)?;
             base64::engine::general_purpose::STANDARD.encode(OrderRow::encode_counts(&shaded, views::DRAWING_RES)?)
         }
@@ -351,7 +351,7 @@ fn drawn_one(
     };
     let translucency = match spec.figure.kind {
         FigureKind::Translucency => {
-            let camera = views::drawing_camera(&mesh.positions, spec.figure.view);
+            let camera = views::drawing_camera(&mesh.positions, spec.figure.view, spec.figure.up);
             let mut fragments = Vec::new();
             cpu::fragments(&mesh.positions, &triangles, &camera, views::DRAWING_RES, &mut fragments)?;
             let picture = measure::translucency::error_picture(&fragments, &buffer.order, views::DRAWING_RES);

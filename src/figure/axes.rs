@@ -342,6 +342,8 @@ fn fnv1a(text: &str) -> usize {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Swatch {
     Line,
+    /// A line with the series' marker on it (line charts, which mark their points).
+    MarkedLine,
     Point,
     Block,
 }
@@ -401,7 +403,8 @@ pub fn legend(area: &Area, colors: &Colors, swatch: Swatch) -> DrawResult {
             }
         };
         match (swatch, marker) {
-            (Swatch::Line, _) => {
+            (Swatch::Line, _) => area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], color.stroke_width(3)))?,
+            (Swatch::MarkedLine, _) => {
                 area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], color.stroke_width(3)))?;
                 if let Some(m) = marker {
                     shape(area, *m, color.filled())?;

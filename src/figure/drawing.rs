@@ -94,6 +94,10 @@ fn cluster_colours(starts: &[usize], by_rank: bool) -> Vec<([u8; 3], u32)> {
 /// tell from the white page.
 const LAST_GREY: u8 = 215;
 
+/// Fewest page pixels a visible triangle must cover, on average, for triangle borders to be
+/// drawn in a corners drawing (below it they would hide the corner colours).
+const MIN_BORDERED_TRIANGLE: f32 = 40.0;
+
 /// Grey levels of the overdraw heat map: 1, 2, 3, 4 and 5 or more fragments shaded at a pixel.
 const OVERDRAW_GREYS: [u8; 5] = [235, 175, 120, 70, 20];
 
@@ -332,13 +336,16 @@ struct Placement {
 }
 
 impl Placement {
-    fn new(mesh: &Mesh, view: [f32; 3]) -> Placement {
-        let camera = views::drawing_camera(&mesh.positions, view);
+    fn new(mesh: &Mesh, view: [f32; 3], up: Option<[f32; 3]>) -> Placement {
+        let camera = views::drawing_camera(&mesh.positions, view, up);
         let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
         for &p in &mesh.positions {
             let q = ndc(&camera, p);
             (lo, hi) = (lo.min(q), hi.max(q));
         }
+        // A margin of 1% each side, so the extremes (a horse's hooves) do not touch the edge.
+        let pad = (hi - lo) * 0.01;
+        (lo, hi) = (lo - pad, hi + pad);
         let size = (hi - lo).max(Vec2::splat(1e-6));
         let width = PANEL_W - 2 * MARGIN;
         let height = ((width as f32 * size.y / size.x).round() as u32).clamp(40, 2 * width);
@@ -359,7 +366,8 @@ fn ndc(camera: &views::Camera, p: Vec3) -> Vec2 {
 
 /// The whole SVG: header, panels in a grid, a legend line.
 fn render(chart: &Chart, drawings: &[Drawing]) -> std::result::Result<String, String> {
-    let placements: Vec<Placement> = drawings.iter().map(|d| Placement::new(d.mesh, chart.figure.view)).collect();
+    let placements: Vec<Placement> =
+        drawings.iter().map(|d| Placement::new(d.mesh, chart.figure.view, chart.figure.up)).collect();
     let cols = match drawings.len() {
         1 => 1,
         2 | 4 => 2,
@@ -465,6 +473,15 @@ fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std
     let (w, h) = (x1.saturating_sub(x0).max(1), y1.saturating_sub(y0).max(1));
     let projected: Vec<Vec2> = positions.iter().map(|&p| ndc(&place.camera, p)).collect();
     let id = |x: usize, y: usize| if x < n && y < n { ids[y * n + x] } else { u32::MAX };
+    // Triangle borders only where triangles are large enough on the page for their colours to
+    // show between them: at 40k triangles in a 500-pixel panel, borders alone would fill it.
+    let covered = ids.iter().filter(|&&t| t != u32::MAX).count();
+    let mut seen: Vec<u32> = ids.iter().copied().filter(|&t| t != u32::MAX).collect();
+    seen.sort_unstable();
+    seen.dedup();
+    let page_scale = place.width as f32 / w as f32;
+    let page_pixels = covered as f32 * page_scale * page_scale / seen.len().max(1) as f32;
+    let triangle_borders = page_pixels >= MIN_BORDERED_TRIANGLE;
     let mut rgb = vec![255u8; w * h * 3];
     for row in 0..h {
         let y = y1 - 1 - row; // image rows run top-down, raster rows bottom-up
@@ -493,7 +510,7 @@ fn mesh_image(drawing: &Drawing, place: &Placement, (ox, oy): (u32, u32)) -> std
                         Corner::Miss(2) => RELOAD,
                         Corner::Miss(_) => LATER_RELOAD,
                     };
-                    (base, id(x + 1, y) != t || id(x, y + 1) != t)
+                    (base, triangle_borders && (id(x + 1, y) != t || id(x, y + 1) != t))
                 }
                 Content::Clusters(colours) => {
                     let cluster = |t: u32| colours.get(t as usize).map(|c| c.1);

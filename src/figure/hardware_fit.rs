@@ -210,12 +210,10 @@ impl Painter for FitPainter<'_> {
         chart.draw_series(LineSeries::new([(lo, lo), (hi, hi)], RGBColor(0xaa, 0xaa, 0xaa).stroke_width(2)))?;
         let (a, b) = least_squares(&self.fit.points.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>());
         chart.draw_series(LineSeries::new([(lo, a + b * lo), (hi, a + b * hi)], BLACK.stroke_width(1)))?;
-        chart.draw_series(
-            self.fit
-                .points
-                .iter()
-                .map(|(x, y, name)| Circle::new((*x, *y), 4, self.colors.of(name).mix(0.85).filled())),
-        )?;
+        for (x, y, name) in &self.fit.points {
+            let style = self.colors.of(name).mix(0.85).filled();
+            super::axes::markers(chart, &[(*x, *y)], self.colors.marker(name), 4, style)?;
+        }
         Ok(())
     }
 }

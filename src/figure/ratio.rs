@@ -140,7 +140,7 @@ impl Painter for RatioPainter<'_> {
         chart.draw_series(LineSeries::new([(x.start, 1.0), (x.end, 1.0)], grey))?;
         for (series, points) in self.points {
             let color = self.colors.of(series).mix(0.8).filled();
-            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color)))?;
+            super::axes::markers(chart, points, self.colors.marker(series), 3, color)?;
         }
         Ok(())
     }

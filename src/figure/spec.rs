@@ -62,6 +62,8 @@ pub struct Figure {
     pub label: Option<String>,
     /// Drawing kinds: the direction the model is seen from (centre → eye), default +z.
     pub view: [f32; 3],
+    /// Drawing kinds: the world direction drawn upwards (default +y, or +z when seen along y).
+    pub up: Option<[f32; 3]>,
     /// Kind `ratio`: the method names whose values are divided, numerator first.
     pub ratio: Option<(String, String)>,
     /// Line and scatter charts of methods: the method names drawn on top with larger, outlined
@@ -158,6 +160,7 @@ pub struct RawFigure {
     y_range: Option<[f64; 2]>,
     label: Option<String>,
     view: Option<[f32; 3]>,
+    up: Option<[f32; 3]>,
     ratio: Option<[String; 2]>,
     #[serde(default)]
     highlight: Vec<String>,
@@ -239,6 +242,17 @@ impl RawFigure {
                 return Err(format!("figure.view = {v:?} must be a finite, non-zero direction"));
             }
             (_, v) => v.unwrap_or([0.0, 0.0, 1.0]),
+        };
+        let up = match (self.kind.draws_meshes(), self.up) {
+            (false, Some(_)) => return Err("figure.up is only for the kinds that draw meshes".into()),
+            (true, Some(u)) => {
+                let (u3, v3) = (glam::Vec3::from(u), glam::Vec3::from(view));
+                if !(u.iter().all(|c| c.is_finite()) && u3.cross(v3).length() > 1e-3 * u3.length() * v3.length()) {
+                    return Err(format!("figure.up = {u:?} must be a finite direction not along figure.view"));
+                }
+                Some(u)
+            }
+            (_, None) => None,
         };
         if self.kind.fixed_layout() && metrics != ["acmr"] {
             return Err(format!(
@@ -369,6 +383,7 @@ impl RawFigure {
             y_range,
             label: self.label,
             view,
+            up,
             ratio,
             highlight: self.highlight,
             relative_to: self.relative_to,

@@ -128,7 +128,8 @@ impl Kind for Tables {
 
 /// How one column writes its numbers: all with the same decimals, so they line up and compare
 /// at a glance (four significant digits of the column's smallest value), or, where that would
-/// take more than six decimals, each on its own (`axes::number`).
+/// take more than six decimals, each with four significant digits; never in e-notation, which
+/// a column of plain decimals would not be read alongside.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Format {
     Fixed(usize),
@@ -148,7 +149,11 @@ impl Format {
     fn write(self, v: f64) -> String {
         match self {
             Format::Fixed(decimals) => format!("{v:.decimals$}"),
-            Format::Each => axes::number(v),
+            Format::Each if v == 0.0 || !v.is_finite() => axes::number(v),
+            Format::Each => {
+                let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+                format!("{v:.decimals$}")
+            }
         }
     }
 }
@@ -181,7 +186,10 @@ mod tests {
         assert_eq!(times.write(1.451), "1.45100");
         let acmr = Format::of([0.6512, 2.999].into_iter());
         assert_eq!(acmr.write(2.999), "2.9990");
-        assert_eq!(Format::of([3.3e-6, 0.2].into_iter()), Format::Each);
+        let tiny = Format::of([3.3e-6, 0.2].into_iter());
+        assert_eq!(tiny, Format::Each);
+        assert_eq!(tiny.write(8.714e-5), "0.00008714");
+        assert_eq!(tiny.write(0.01281), "0.01281");
     }
 
     #[test]

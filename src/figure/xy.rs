@@ -76,7 +76,7 @@ impl Kind for Xy {
     }
 
     fn swatch(&self) -> Swatch {
-        if self.lines { Swatch::Line } else { Swatch::Point }
+        if self.lines { Swatch::MarkedLine } else { Swatch::Point }
     }
 
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult {

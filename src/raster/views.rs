@@ -96,8 +96,12 @@ pub const DRAWING_RES: u32 = 1024;
 
 /// The camera a drawing sees `positions` with: orthographic along `view` (centre → eye), the
 /// model framed as for measurements.
-pub fn drawing_camera(positions: &[Vec3], view: [f32; 3]) -> Camera {
-    orthographic(Framing::of(positions), Vec3::from(view).normalize())
+pub fn drawing_camera(positions: &[Vec3], view: [f32; 3], up: Option<[f32; 3]>) -> Camera {
+    let direction = Vec3::from(view).normalize();
+    match up {
+        Some(up) => orthographic_up(Framing::of(positions), direction, Vec3::from(up)),
+        None => orthographic(Framing::of(positions), direction),
+    }
 }
 
 /// A named set of views.
@@ -180,7 +184,13 @@ fn up_for(direction: Vec3) -> Vec3 {
 /// Orthographic camera looking at the centre from `direction` (unit vector centre → eye), at
 /// twice the radius: built in the unit frame ([`Camera`]).
 pub fn orthographic(framing: Framing, direction: Vec3) -> Camera {
-    let view = look_at_mat4(direction * 2.0, Vec3::ZERO, up_for(direction));
+    orthographic_up(framing, direction, up_for(direction))
+}
+
+/// [`orthographic`] with the image's up given: a model whose up axis is not +Y (the GaTech
+/// horse stands along Z) is drawn standing.
+pub fn orthographic_up(framing: Framing, direction: Vec3, up: Vec3) -> Camera {
+    let view = look_at_mat4(direction * 2.0, Vec3::ZERO, up);
     let proj = directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.5, 3.5);
     camera(framing, direction, 2.0, proj * view, false)
 }
