@@ -209,16 +209,22 @@ pub fn plot(chart: &Chart, table: &Table) -> Result<std::path::PathBuf> {
                         if res != views::DRAWING_RES {
                             return Err(picture(format!("{res}² pixels")));
                         }
-                        let content = match kind {
-                            FigureKind::Translucency => Content::Translucency(levels),
-                            _ => Content::Overdraw(levels),
-                        };
-                        (content, String::new())
+                        match kind {
+                            FigureKind::Translucency => (Content::Translucency(levels), String::new()),
+                            _ => {
+                                // The overdraw ratio of exactly this picture (N06 Fig. 1 gives it per view).
+                                let shaded: u64 = levels.iter().map(|&k| u64::from(k)).sum();
+                                let covered = levels.iter().filter(|&&k| k > 0).count().max(1);
+                                let ovr = shaded as f64 / covered as f64;
+                                let note = format!("OVR {} from this view ({res}²) · ", axes::number(ovr));
+                                (Content::Overdraw(levels), note)
+                            }
+                        }
                     }
                 };
                 drawings.push(Drawing {
                     mesh,
-                    title: format!("{label}{name} · {clusters}{cache} ACMR {}", axes::number(acmr)),
+                    title: format!("{label}{name} · {clusters}ACMR {} at {cache}", axes::number(acmr)),
                     triangles,
                     kind: content,
                 });
