@@ -247,6 +247,17 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Rewrite the tables generated from results CSVs in the gallery (paper-figures/README.md):
+    /// each sits between `<!-- generated from results/ID.csv: … -->` and `<!-- end generated -->`
+    /// and is never typed by hand (src/figure/gallery.rs has the recipe syntax).
+    Gallery {
+        /// Only check: exit with status 2, naming the stale tables, when one differs from its CSV.
+        #[arg(long)]
+        check: bool,
+        /// The markdown file to refresh.
+        #[arg(long, default_value = "paper-figures/README.md")]
+        file: PathBuf,
+    },
     /// Run and plot every experiment in experiments/.
     Reproduce {
         /// Small models and views only: works on a fresh clone with no data directory.
@@ -294,6 +305,7 @@ fn main() -> ExitCode {
         Command::Run { spec, quick, backend, shard } => commands::run(&spec, quick, backend, shard.as_deref(), common),
         Command::Merge { spec, quick, shards } => commands::merge(&spec, quick, shards, common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick, common),
+        Command::Gallery { check, file } => commands::gallery(&file, check),
         Command::Reproduce { quick, only, backend } => commands::reproduce(quick, only.as_deref(), backend, common),
         Command::Bench { reps, meshes, only } => commands::bench(reps, &meshes, only, common),
     };

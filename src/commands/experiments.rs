@@ -2,12 +2,12 @@
 
 use std::path::Path;
 
-use triorder::Result;
 use triorder::experiment::shard::Shard;
 use triorder::experiment::{self, Failure, RunOptions, provenance};
 use triorder::figure::PlotOptions;
 use triorder::mesh::{Source, source};
 use triorder::reproduce;
+use triorder::{Error, Result};
 use triorder::{measure, raster};
 
 use crate::{BenchPart, Common};
@@ -74,6 +74,26 @@ fn failures<'a>(failed: impl Iterator<Item = (&'a str, &'a Failure)>, csv: &Path
 pub fn plot(spec: &Path, quick: bool, common: &Common) -> Result<()> {
     let svg = reproduce::plot(spec, &PlotOptions { quick, data: common.data.clone(), ..Default::default() })?;
     println!("wrote {}", svg.display());
+    Ok(())
+}
+
+pub fn gallery(file: &Path, check: bool) -> Result<()> {
+    let text = std::fs::read_to_string(file).map_err(|e| Error::input(file.display(), e))?;
+    // Its CSVs are named from the project root: the folder above paper-figures/.
+    let root = file.parent().and_then(Path::parent).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let (fresh, sources) = triorder::figure::gallery::refresh(&text, root, file)?;
+    if fresh == text {
+        println!("{}: {} generated tables, all as their CSVs give them", file.display(), sources.len());
+        return Ok(());
+    }
+    if check {
+        return Err(Error::input(
+            file.display(),
+            "a generated table differs from its CSV; run `triorder gallery` to rewrite it",
+        ));
+    }
+    triorder::atomic::write(file, fresh.as_bytes())?;
+    println!("{}: rewrote {} generated tables from their CSVs", file.display(), sources.len());
     Ok(())
 }
 

@@ -5,7 +5,7 @@ mod asset;
 mod experiments;
 mod tables;
 
-pub use experiments::{bench, merge, plot, reproduce, run};
+pub use experiments::{bench, gallery, merge, plot, reproduce, run};
 
 use std::path::Path;
 

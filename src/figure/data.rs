@@ -375,7 +375,7 @@ pub fn parameter<'a>(spec: &'a str, name: &str) -> Option<&'a str> {
 }
 
 /// `47794` → `47,794`.
-fn thousands(digits: &str) -> String {
+pub(crate) fn thousands(digits: &str) -> String {
     if !digits.bytes().all(|b| b.is_ascii_digit()) {
         return digits.to_string();
     }

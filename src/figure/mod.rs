@@ -12,6 +12,7 @@ mod bar;
 pub(crate) mod data;
 mod distribution;
 mod drawing;
+pub mod gallery;
 mod hardware_fit;
 mod ratio;
 pub mod spec;
