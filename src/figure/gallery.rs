@@ -17,11 +17,13 @@
 //! - `cells`: what each cell shows, one or more values joined by ` / `: a metric name, optionally
 //!   with conditions on other columns, `acmr@cache_size=16`. With `cols=cells` each of them is a
 //!   column of its own instead.
-//! - `filter` (optional): `COLUMN=V1,V2;COLUMN=V` keeps only rows with one of those values.
+//! - `filter` (optional): `COLUMN=V1|V2;COLUMN=V` keeps only rows with one of those values (a
+//!   `method` value may name only some parameters: `nehab:clusters=64`).
 //! - `digits` (optional, default 3): decimals of every number, or `s3` for three significant
 //!   digits each (times that span orders of magnitude).
 //! - `relative_to` (optional): a value of `cols`; each cell shows that column's value in the
 //!   same row divided by its own, written `N×` (how many times lower), higher then best.
+//! - `percent=yes` (optional): shares written as percentages.
 //! - `best` (optional): `row` or `col` writes the lowest of each value of a cell across its row
 //!   or column in bold (lower is better for every metric we have); `input` never counts as best.
 //!
@@ -50,6 +52,8 @@ struct Recipe {
     best: Best,
     /// The column (a value of `cols`) each cell is divided into: `REF ÷ cell`, written `N×`.
     relative_to: Option<String>,
+    /// Shares written as percentages (× 100, `%`).
+    percent: bool,
 }
 
 /// How numbers are written: fixed decimals, or significant digits (for times spanning orders of
@@ -64,7 +68,8 @@ impl Digits {
     fn write(self, v: f64) -> String {
         let decimals = match self {
             Digits::Decimals(d) => d,
-            Digits::Significant(_) if v == 0.0 || !v.is_finite() => 0,
+            // Counts (rounds, buffers) are whole numbers: written whole.
+            Digits::Significant(_) if v == 0.0 || !v.is_finite() || v.fract() == 0.0 => 0,
             Digits::Significant(n) => (n as i32 - 1 - v.abs().log10().floor() as i32).clamp(0, 12) as usize,
         };
         format!("{v:.decimals$}")
@@ -91,6 +96,7 @@ impl Recipe {
             digits: Digits::Decimals(3),
             best: Best::None,
             relative_to: None,
+            percent: false,
         };
         for option in options.split_whitespace() {
             let (key, value) = option.split_once('=').ok_or_else(|| format!("`{option}` is not KEY=VALUE"))?;
@@ -114,8 +120,8 @@ impl Recipe {
                 "filter" => {
                     for f in value.split(';') {
                         let (column, values) =
-                            f.split_once('=').ok_or_else(|| format!("filter `{f}` is not COLUMN=V1,V2"))?;
-                        recipe.filter.push((column.to_string(), values.split(',').map(str::to_string).collect()));
+                            f.split_once('=').ok_or_else(|| format!("filter `{f}` is not COLUMN=V1|V2"))?;
+                        recipe.filter.push((column.to_string(), values.split('|').map(str::to_string).collect()));
                     }
                 }
                 "digits" => {
@@ -134,9 +140,10 @@ impl Recipe {
                     }
                 }
                 "relative_to" => recipe.relative_to = Some(value.to_string()),
+                "percent" => recipe.percent = value == "yes",
                 _ => {
                     return Err(format!(
-                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to)"
+                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent)"
                     ));
                 }
             }
@@ -178,7 +185,11 @@ impl Recipe {
                         None => triangles.push((cells[m].clone(), count)),
                     }
                 }
-                let kept = self.filter.iter().enumerate().all(|(i, (_, vs))| vs.contains(&cells[filter_at + i]));
+                let kept = self
+                    .filter
+                    .iter()
+                    .enumerate()
+                    .all(|(i, (column, vs))| vs.iter().any(|v| matches(column, v, &cells[filter_at + i])));
                 let met = conds.iter().enumerate().all(|(i, (_, v))| cells[cond_at + i] == *v);
                 if !kept || !met {
                     continue;
@@ -289,7 +300,11 @@ impl Recipe {
             competitors.len() > 1 && competitors.iter().all(|&o| better(v, o))
         };
         let digits = self.digits;
-        let suffix = if self.relative_to.is_some() { "×" } else { "" };
+        let (suffix, scale) = match (self.relative_to.is_some(), self.percent) {
+            (true, _) => ("×", 1.0),
+            (false, true) => ("%", 100.0),
+            (false, false) => ("", 1.0),
+        };
         let mut out = String::new();
         let _ = writeln!(out, "| {} | {} |", row_parts.join(", "), col_names.join(" | "));
         let _ = writeln!(out, "|---{}|", "|---".repeat(cols.len()));
@@ -299,8 +314,8 @@ impl Recipe {
                     let parts: Vec<String> = (0..cell_count)
                         .map(|k| match value(r, c, k) {
                             None => "–".to_string(),
-                            Some(v) if best(r, c, k) => format!("**{}{suffix}**", digits.write(v)),
-                            Some(v) => format!("{}{suffix}", digits.write(v)),
+                            Some(v) if best(r, c, k) => format!("**{}{suffix}**", digits.write(v * scale)),
+                            Some(v) => format!("{}{suffix}", digits.write(v * scale)),
                         })
                         .collect();
                     parts.join(" / ")
@@ -310,6 +325,19 @@ impl Recipe {
         }
         Ok(out)
     }
+}
+
+/// Whether a filter value `wanted` keeps a row whose `column` is `cell`: equal, or for a
+/// method spec, the same method with at least the parameters `wanted` names at its values
+/// (`nehab:clusters=64` keeps `nehab:clusters=64,views=162,…`).
+fn matches(column: &str, wanted: &str, cell: &str) -> bool {
+    if wanted == cell {
+        return true;
+    }
+    let (Some((name, params)), Some((cell_name, cell_params))) = (wanted.split_once(':'), cell.split_once(':')) else {
+        return false;
+    };
+    column == "method" && name == cell_name && params.split(',').all(|kv| cell_params.split(',').any(|c| c == kv))
 }
 
 /// A column heading for a cell value: the metric, then its conditions.
@@ -371,6 +399,7 @@ models/b.ply,2000,hoppe:cache=16,hoppe,acmr,16,0.9
         std::fs::write(dir.path().join("results/x.csv"), CSV).unwrap();
         assert_eq!(Digits::Significant(3).write(0.000012345), "0.0000123");
         assert_eq!(Digits::Significant(3).write(1.2345), "1.23");
+        assert_eq!(Digits::Significant(2).write(9.0), "9");
         let text = "intro\n<!-- generated from results/x.csv: rows=model cols=method_name cells=acmr@cache_size=16/acmr@cache_size=32 digits=2 best=row -->\n| stale |\n<!-- end generated -->\nafter\n";
         let (fresh, sources) = refresh(text, dir.path(), Path::new("README.md")).unwrap();
         assert_eq!(sources, ["results/x.csv"]);
