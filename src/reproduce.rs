@@ -39,6 +39,8 @@ pub struct Outcome {
     pub ran: Vec<Ran>,
     /// Each spec skipped, and why.
     pub skipped: Vec<(String, String)>,
+    /// The gallery whose generated tables were rewritten from the new CSVs, if there is one.
+    pub gallery: Option<PathBuf>,
     /// Each model (and method) that failed in a spec, which went on without it: the spec's id and
     /// the failure.
     pub failures: Vec<(String, crate::experiment::Failure)>,
@@ -96,6 +98,16 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
         overall.inc(1);
     }
     overall.finish_and_clear();
+    // The gallery's generated tables follow the CSVs just written (a quick run writes elsewhere).
+    let gallery = opts.out_dir.join("paper-figures/README.md");
+    if !opts.quick && gallery.is_file() {
+        let text = std::fs::read_to_string(&gallery).map_err(|e| Error::input(gallery.display(), e))?;
+        let (fresh, _) = figure::gallery::refresh(&text, &opts.out_dir, &gallery)?;
+        if fresh != text {
+            crate::atomic::write(&gallery, fresh.as_bytes())?;
+        }
+        outcome.gallery = Some(gallery);
+    }
     outcome.device = device.and_then(|d| d.ok());
     outcome.seconds = start.elapsed().as_secs_f64();
     Ok(outcome)

@@ -102,6 +102,9 @@ pub fn reproduce(quick: bool, only: Option<&str>, backend: Option<String>, commo
     for ran in &outcome.ran {
         println!("wrote {} and {} ({:.1} s)", ran.csv.display(), ran.svg.display(), ran.seconds);
     }
+    if let Some(gallery) = &outcome.gallery {
+        println!("rewrote the generated tables of {} from the CSVs", gallery.display());
+    }
     print!("{}", summary(&outcome, quick));
     Ok(())
 }
