@@ -23,6 +23,8 @@ pub struct Bars {
     pub values: Vec<Vec<Vec<Option<f64>>>>,
     /// The same shape: the text written above each bar instead of its value, where not empty.
     pub labels: Vec<Vec<Vec<String>>>,
+    /// The same shape: the least and greatest run a bar is the mean of (`figure.spread`).
+    pub ranges: Vec<Vec<Vec<Option<(f64, f64)>>>>,
 }
 
 impl Bars {
@@ -39,15 +41,17 @@ impl Bars {
                 }
             }
         }
-        let (mut values, mut labels) = (Vec::new(), Vec::new());
+        let (mut values, mut labels, mut ranges) = (Vec::new(), Vec::new(), Vec::new());
         for panel in panels {
-            let (mut panel_values, mut panel_labels) = (Vec::new(), Vec::new());
+            let (mut panel_values, mut panel_labels, mut panel_ranges) = (Vec::new(), Vec::new(), Vec::new());
             for name in &series {
                 let found = panel.series.iter().find(|s| s.name == *name);
+                let mut r = Vec::new();
                 let (v, l): (Vec<Option<f64>>, Vec<String>) = categories
                     .iter()
                     .map(|c| {
                         let point = found.and_then(|s| Some((s, s.points.iter().position(|(x, _)| x == c)?)));
+                        r.push(point.and_then(|(s, i)| s.ranges.get(i).copied().flatten()));
                         point.map_or((None, String::new()), |(s, i)| {
                             (Some(s.points[i].1), s.labels.get(i).cloned().unwrap_or_default())
                         })
@@ -55,11 +59,13 @@ impl Bars {
                     .unzip();
                 panel_values.push(v);
                 panel_labels.push(l);
+                panel_ranges.push(r);
             }
             values.push(panel_values);
             labels.push(panel_labels);
+            ranges.push(panel_ranges);
         }
-        Bars { categories, series, values, labels }
+        Bars { categories, series, values, labels, ranges }
     }
 }
 
@@ -69,12 +75,20 @@ impl Kind for Bars {
             Some(i) => &self.values[i..=i],
             None => &self.values[..],
         };
-        let all: Vec<f64> = panels.iter().flatten().flatten().flatten().copied().collect();
+        let ranges = match panel {
+            Some(i) => &self.ranges[i..=i],
+            None => &self.ranges[..],
+        };
+        let mut all: Vec<f64> = panels.iter().flatten().flatten().flatten().copied().collect();
+        // Whiskers must fit too (not counted as bars for the outlier rule: `bars` is `all` before).
+        let whiskers = ranges.iter().flatten().flatten().flatten().flat_map(|&(lo, hi)| [lo, hi]);
+        let bars = all.clone();
+        all.extend(whiskers);
         Extent {
             x: XAxis::Categories(self.categories.clone()),
             y: super::span(all.iter().copied()).unwrap_or((0.0, 1.0)),
             from_zero: true,
-            bars: all,
+            bars,
         }
     }
 
@@ -115,6 +129,7 @@ impl Kind for Bars {
                 bars: self,
                 values: &keep_columns(values, &own),
                 labels: &keep_columns(&self.labels[index], &own),
+                ranges: &keep_columns(&self.ranges[index], &own),
                 colors,
                 base: frame.y.start,
             },
@@ -131,6 +146,7 @@ struct BarPainter<'a> {
     bars: &'a Bars,
     values: &'a [Vec<Option<f64>>],
     labels: &'a [Vec<String>],
+    ranges: &'a [Vec<Option<(f64, f64)>>],
     colors: &'a Colors,
     /// Where bars start: 0, or the bottom of a log axis.
     base: f64,
@@ -181,8 +197,20 @@ impl Painter for BarPainter<'_> {
                 }
                 chart
                     .draw_series(std::iter::once(Rectangle::new([(left, base), (left + width, y)], color.filled())))?;
+                if let Some((lo, hi)) = self.ranges[j][i] {
+                    // The spread of the runs (seeds) this bar is the mean of: a whisker with caps.
+                    let (mid, cap) = (left + width / 2.0, width / 6.0);
+                    let style = BLACK.stroke_width(2);
+                    chart.draw_series([
+                        PathElement::new(vec![(mid, lo), (mid, hi)], style),
+                        PathElement::new(vec![(mid - cap, lo), (mid + cap, lo)], style),
+                        PathElement::new(vec![(mid - cap, hi), (mid + cap, hi)], style),
+                    ])?;
+                }
                 if pixels >= MIN_LABELLED_BAR {
-                    let top = EmptyElement::at((left + width / 2.0, y)) + Text::new(text, (0, -3), label.clone());
+                    // Above the whisker, where there is one.
+                    let above = self.ranges[j][i].map_or(y, |(_, hi)| hi.max(y));
+                    let top = EmptyElement::at((left + width / 2.0, above)) + Text::new(text, (0, -3), label.clone());
                     chart.draw_series(std::iter::once(top))?;
                 }
             }

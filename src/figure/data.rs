@@ -33,6 +33,9 @@ pub struct Series {
     pub points: Vec<(String, f64)>,
     /// Per point, the figure's `label` cell (empty without one, or where the row has none).
     pub labels: Vec<String>,
+    /// Per point, the least and greatest value it is the mean of, where the figure's `spread`
+    /// folded several runs (seeds) into it; empty otherwise.
+    pub ranges: Vec<Option<(f64, f64)>>,
 }
 
 /// The value of `key` in the animated model `model` (a `model` cell of a results CSV), defaults
@@ -220,15 +223,30 @@ impl Table {
                     panels.last_mut().expect("just pushed")
                 }
             };
-            let name = series.label(record);
+            let mut name = series.label(record);
+            if let Some(p) = &figure.spread {
+                // Runs that differ only in the spread parameter are one series (or category).
+                if figure.series == "method" {
+                    name = without_parameter(&name, p);
+                }
+                if figure.x.as_deref() == Some("method") {
+                    x = without_parameter(&x, p);
+                }
+            }
             let series = match panel.series.iter().position(|s| s.name == name) {
                 Some(s) => &mut panel.series[s],
                 None => {
-                    panel.series.push(Series { name: name.clone(), points: Vec::new(), labels: Vec::new() });
+                    panel.series.push(Series {
+                        name: name.clone(),
+                        points: Vec::new(),
+                        labels: Vec::new(),
+                        ranges: Vec::new(),
+                    });
                     panel.series.last_mut().expect("just pushed")
                 }
             };
             if matches!(figure.kind, FigureKind::Line | FigureKind::Bar | FigureKind::Table)
+                && figure.spread.is_none()
                 && series.points.iter().any(|(px, _)| *px == x)
             {
                 return Err(Error::input(
@@ -242,6 +260,11 @@ impl Table {
             }
             series.points.push((x, y));
             series.labels.push(label.as_ref().map_or(String::new(), |l| l.cell(record)));
+        }
+        if figure.spread.is_some() {
+            for series in panels.iter_mut().flat_map(|p| &mut p.series) {
+                fold_spread(series);
+            }
         }
         shorten_methods(figure, &mut panels);
         if panels.is_empty() {
@@ -304,6 +327,35 @@ impl Column {
             _ => cell,
         }
     }
+}
+
+/// `spec` (`method:k=v,…`) without parameter `name`.
+fn without_parameter(spec: &str, name: &str) -> String {
+    let Some((method, params)) = spec.split_once(':') else { return spec.to_string() };
+    let kept: Vec<&str> = params.split(',').filter(|kv| kv.split('=').next() != Some(name)).collect();
+    if kept.is_empty() { method.to_string() } else { format!("{method}:{}", kept.join(",")) }
+}
+
+/// The points of `series` that share an x folded into one: their mean, with the least and
+/// greatest as its range (a single point has none).
+fn fold_spread(series: &mut Series) {
+    let mut xs: Vec<String> = Vec::new();
+    for (x, _) in &series.points {
+        if !xs.contains(x) {
+            xs.push(x.clone());
+        }
+    }
+    let (mut points, mut labels, mut ranges) = (Vec::new(), Vec::new(), Vec::new());
+    for x in xs {
+        let at: Vec<usize> = (0..series.points.len()).filter(|&i| series.points[i].0 == x).collect();
+        let values: Vec<f64> = at.iter().map(|&i| series.points[i].1).collect();
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        labels.push(series.labels[at[0]].clone());
+        ranges.push((values.len() > 1).then_some((lo, hi)));
+        points.push((x, mean));
+    }
+    (series.points, series.labels, series.ranges) = (points, labels, ranges);
 }
 
 /// Writes the method specs a figure shows (as series, x categories or panel titles) as their
@@ -392,6 +444,21 @@ pub(crate) fn thousands(digits: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn runs_of_several_seeds_fold_into_a_mean_and_its_range() {
+        assert_eq!(without_parameter("nehab:clusters=64,seed=3", "seed"), "nehab:clusters=64");
+        assert_eq!(without_parameter("random:seed=3", "seed"), "random");
+        let mut series = Series {
+            name: "nehab".into(),
+            points: vec![("a".into(), 1.0), ("b".into(), 5.0), ("a".into(), 3.0)],
+            labels: vec![String::new(); 3],
+            ranges: Vec::new(),
+        };
+        fold_spread(&mut series);
+        assert_eq!(series.points, [("a".to_string(), 2.0), ("b".to_string(), 5.0)]);
+        assert_eq!(series.ranges, [Some((1.0, 3.0)), None]);
+    }
 
     #[test]
     fn method_specs_are_shown_by_what_tells_them_apart() {

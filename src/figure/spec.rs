@@ -69,6 +69,9 @@ pub struct Figure {
     /// Line and scatter charts of methods: the method names drawn on top with larger, outlined
     /// markers (a new method and its peers among every ordering, issue 19).
     pub highlight: Vec<String>,
+    /// A method parameter (`seed`) whose runs are folded into one point: their mean, drawn with
+    /// whiskers from the least to the greatest (bars, lines and scatters).
+    pub spread: Option<String>,
     /// Tables of methods: each cell shows this method's value ÷ the cell's (how many times lower
     /// than the reference, the form of Nehab et al.'s "variance drops 50×"); higher is better.
     pub relative_to: Option<String>,
@@ -165,6 +168,7 @@ pub struct RawFigure {
     #[serde(default)]
     highlight: Vec<String>,
     relative_to: Option<String>,
+    spread: Option<String>,
 }
 
 /// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
@@ -359,6 +363,20 @@ impl RawFigure {
                 return Err(format!("figure.relative_to names `{reference}`, which is not a method of this spec"));
             }
         }
+        if let Some(param) = &self.spread {
+            if !matches!(self.kind, FigureKind::Bar | FigureKind::Line | FigureKind::Scatter) {
+                return Err(format!(
+                    "figure.spread is for bar, line and scatter charts, not \"{}\"",
+                    kind_name(self.kind)
+                ));
+            }
+            if series != "method" && self.x.as_deref() != Some("method") {
+                return Err("figure.spread folds method specs: set series or x to \"method\"".into());
+            }
+            if !methods.iter().any(|m| data::parameter(m, param).is_some()) {
+                return Err(format!("figure.spread `{param}`: no method of this spec has that parameter"));
+            }
+        }
         let y_range = match self.y_range {
             Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
                 return Err(format!("figure.y_range = [{lo}, {hi}] must be two finite numbers, low < high"));
@@ -387,6 +405,7 @@ impl RawFigure {
             ratio,
             highlight: self.highlight,
             relative_to: self.relative_to,
+            spread: self.spread,
         })
     }
 }

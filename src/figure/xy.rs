@@ -14,8 +14,8 @@ use crate::error::{Error, Result};
 /// Lines drawn with a marker at every point only when there are few enough to tell apart.
 const MAX_MARKED_POINTS: usize = 24;
 
-/// A series' name and its `(x, y)` points.
-type Curve = (String, Vec<(f64, f64)>);
+/// A series' name, its `(x, y)` points, and per point the range of the runs it is the mean of.
+type Curve = (String, Vec<(f64, f64)>, Vec<Option<(f64, f64)>>);
 
 /// Numeric points per series per panel.
 pub struct Xy {
@@ -40,16 +40,18 @@ impl Xy {
                         let mut points = series
                             .points
                             .iter()
-                            .map(|(text, y)| match text.parse::<f64>() {
-                                Ok(v) if v.is_finite() => Ok((v, *y)),
+                            .enumerate()
+                            .map(|(i, (text, y))| match text.parse::<f64>() {
+                                Ok(v) if v.is_finite() => Ok(((v, *y), series.ranges.get(i).copied().flatten())),
                                 _ => Err(Error::input(
                                     csv.display(),
                                     format!("column `{x}` has `{text}`, not a number: line and scatter charts need a numeric figure.x (use kind = \"bar\" for categories)"),
                                 )),
                             })
                             .collect::<Result<Vec<_>>>()?;
-                        points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                        Ok((series.name.clone(), points))
+                        points.sort_by(|a, b| a.0.0.total_cmp(&b.0.0));
+                        let (points, ranges) = points.into_iter().unzip();
+                        Ok((series.name.clone(), points, ranges))
                     })
                     .collect::<Result<Vec<_>>>()
             })
@@ -63,7 +65,12 @@ impl Xy {
             Some(i) => &self.panels[i..=i],
             None => &self.panels[..],
         };
-        panels.iter().flatten().flat_map(|(_, p)| p.iter().copied())
+        // Whisker ends count as points, so that the axes hold them.
+        panels.iter().flatten().flat_map(|(_, p, r)| {
+            p.iter()
+                .copied()
+                .chain(p.iter().zip(r).filter_map(|(&(x, _), r)| r.map(|(lo, hi)| [(x, lo), (x, hi)])).flatten())
+        })
     }
 }
 
@@ -147,8 +154,8 @@ impl Painter for XyPainter<'_> {
         // Grey context first, then the others, so that the highlighted series are never hidden.
         let rank = |name: &str| usize::from(!self.colors.is_context(name)) + usize::from(highlighted(name));
         let mut order: Vec<&Curve> = self.series.iter().collect();
-        order.sort_by_key(|(name, _)| rank(name));
-        for (name, points) in order {
+        order.sort_by_key(|(name, _, _)| rank(name));
+        for (name, points, ranges) in order {
             let (color, shape) = (self.colors.of(name), self.colors.marker(name));
             let runs = if self.lines { measured_runs(points, self.x_log) } else { Vec::new() };
             // A dense line is marked at a few evenly spaced points, enough to tell its marker,
@@ -160,6 +167,15 @@ impl Painter for XyPainter<'_> {
                 let lone = runs.iter().filter(|r| r.len() == 1).map(|r| r[0]);
                 points.iter().step_by(step).copied().chain(lone).collect()
             };
+            // The spread of the runs (seeds) a point is the mean of: a whisker.
+            for (&(x, _), range) in points.iter().zip(ranges) {
+                if let Some((lo, hi)) = range {
+                    chart.draw_series(std::iter::once(PathElement::new(
+                        vec![(x, *lo), (x, *hi)],
+                        color.stroke_width(2),
+                    )))?;
+                }
+            }
             if self.colors.is_context(name) {
                 draw_runs(chart, &runs, color.stroke_width(1))?;
             } else if highlighted(name) && self.lines {
