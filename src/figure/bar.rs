@@ -16,6 +16,9 @@ const GROUP_WIDTH: f64 = 0.8;
 /// Narrowest bar (pixels) that gets its value written on it.
 const MIN_LABELLED_BAR: i32 = 30;
 
+/// The least and greatest of the runs a bar is the mean of.
+type Range = (f64, f64);
+
 /// Values per panel, per series (in legend order), per category.
 pub struct Bars {
     pub categories: Vec<String>,
@@ -24,7 +27,7 @@ pub struct Bars {
     /// The same shape: the text written above each bar instead of its value, where not empty.
     pub labels: Vec<Vec<Vec<String>>>,
     /// The same shape: the least and greatest run a bar is the mean of (`figure.spread`).
-    pub ranges: Vec<Vec<Vec<Option<(f64, f64)>>>>,
+    pub ranges: Vec<Vec<Vec<Option<Range>>>>,
 }
 
 impl Bars {
@@ -146,7 +149,7 @@ struct BarPainter<'a> {
     bars: &'a Bars,
     values: &'a [Vec<Option<f64>>],
     labels: &'a [Vec<String>],
-    ranges: &'a [Vec<Option<(f64, f64)>>],
+    ranges: &'a [Vec<Option<Range>>],
     colors: &'a Colors,
     /// Where bars start: 0, or the bottom of a log axis.
     base: f64,
