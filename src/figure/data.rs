@@ -330,7 +330,7 @@ impl Column {
 }
 
 /// `spec` (`method:k=v,…`) without parameter `name`.
-fn without_parameter(spec: &str, name: &str) -> String {
+pub(crate) fn without_parameter(spec: &str, name: &str) -> String {
     let Some((method, params)) = spec.split_once(':') else { return spec.to_string() };
     let kept: Vec<&str> = params.split(',').filter(|kv| kv.split('=').next() != Some(name)).collect();
     if kept.is_empty() { method.to_string() } else { format!("{method}:{}", kept.join(",")) }

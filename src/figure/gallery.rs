@@ -24,6 +24,8 @@
 //! - `relative_to` (optional): a value of `cols`; each cell shows that column's value in the
 //!   same row divided by its own, written `N×` (how many times lower), higher then best.
 //! - `percent=yes` (optional): shares written as percentages.
+//! - `spread` (optional): a method parameter (`seed`) whose runs fold into one cell, written as
+//!   their mean with the least and greatest in brackets.
 //! - `best` (optional): `row` or `col` writes the lowest of each value of a cell across its row
 //!   or column in bold (lower is better for every metric we have); `input` never counts as best.
 //!
@@ -54,6 +56,9 @@ struct Recipe {
     relative_to: Option<String>,
     /// Shares written as percentages (× 100, `%`).
     percent: bool,
+    /// A method parameter (`seed`) whose runs fold into one cell: their mean, then the least to
+    /// the greatest in brackets.
+    spread: Option<String>,
 }
 
 /// How numbers are written: fixed decimals, or significant digits (for times spanning orders of
@@ -97,6 +102,7 @@ impl Recipe {
             best: Best::None,
             relative_to: None,
             percent: false,
+            spread: None,
         };
         for option in options.split_whitespace() {
             let (key, value) = option.split_once('=').ok_or_else(|| format!("`{option}` is not KEY=VALUE"))?;
@@ -141,9 +147,10 @@ impl Recipe {
                 }
                 "relative_to" => recipe.relative_to = Some(value.to_string()),
                 "percent" => recipe.percent = value == "yes",
+                "spread" => recipe.spread = Some(value.to_string()),
                 _ => {
                     return Err(format!(
-                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent)"
+                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent, spread)"
                     ));
                 }
             }
@@ -175,7 +182,7 @@ impl Recipe {
         let mut values: Vec<((usize, usize, usize), f64)> = Vec::new();
         let mut cond_at = filter_at + self.filter.len();
         for (k, (metric, conds)) in self.cells.iter().enumerate() {
-            for (cells, value) in table.rows(metric, &columns)? {
+            for (mut cells, value) in table.rows(metric, &columns)? {
                 // A model is named by its full triangle count: the most any of its rows has
                 // (progressive levels have fewer).
                 if let Some(m) = columns.iter().position(|c| *c == "model") {
@@ -194,6 +201,11 @@ impl Recipe {
                 if !kept || !met {
                     continue;
                 }
+                if let Some(param) = &self.spread {
+                    for p in (0..keys).filter(|&p| columns[p] == "method") {
+                        cells[p] = super::data::without_parameter(&cells[p], param);
+                    }
+                }
                 let index = |list: &mut Vec<Vec<String>>, key: &[String]| {
                     list.iter().position(|x| x == key).unwrap_or_else(|| {
                         list.push(key.to_vec());
@@ -206,7 +218,7 @@ impl Recipe {
                 } else {
                     (index(&mut cols, &cells[n_rows..keys]), k)
                 };
-                if values.iter().any(|(key, _)| *key == (r, c, k)) {
+                if self.spread.is_none() && values.iter().any(|(key, _)| *key == (r, c, k)) {
                     return Err(Error::input(
                         &path,
                         format!(
@@ -269,7 +281,19 @@ impl Recipe {
             (label(&row_parts, &rows), label(&col_parts, &cols))
         };
         let cell_count = if by_cell { 1 } else { self.cells.len() };
-        let raw = |r: usize, c: usize, k: usize| values.iter().find(|(key, _)| *key == (r, c, k)).map(|(_, v)| *v);
+        // Every run at a cell (several only with `spread`): their mean, and their range.
+        let runs = |r: usize, c: usize, k: usize| -> Vec<f64> {
+            values.iter().filter(|(key, _)| *key == (r, c, k)).map(|(_, v)| *v).collect()
+        };
+        let raw = |r: usize, c: usize, k: usize| {
+            let all = runs(r, c, k);
+            (!all.is_empty()).then(|| all.iter().sum::<f64>() / all.len() as f64)
+        };
+        let range = |r: usize, c: usize, k: usize| {
+            let all = runs(r, c, k);
+            (all.len() > 1)
+                .then(|| all.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v))))
+        };
         let reference =
             match &self.relative_to {
                 None => None,
@@ -314,8 +338,16 @@ impl Recipe {
                     let parts: Vec<String> = (0..cell_count)
                         .map(|k| match value(r, c, k) {
                             None => "–".to_string(),
-                            Some(v) if best(r, c, k) => format!("**{}{suffix}**", digits.write(v * scale)),
-                            Some(v) => format!("{}{suffix}", digits.write(v * scale)),
+                            Some(v) => {
+                                let text = format!("{}{suffix}", digits.write(v * scale));
+                                let text = if best(r, c, k) { format!("**{text}**") } else { text };
+                                match range(r, c, k).filter(|_| reference.is_none()) {
+                                    Some((lo, hi)) => {
+                                        format!("{text} ({}–{})", digits.write(lo * scale), digits.write(hi * scale))
+                                    }
+                                    None => text,
+                                }
+                            }
                         })
                         .collect();
                     parts.join(" / ")
@@ -410,6 +442,20 @@ models/b.ply,2000,hoppe:cache=16,hoppe,acmr,16,0.9
         assert_eq!(fresh, want);
         // Regenerating a fresh table changes nothing.
         assert_eq!(refresh(&fresh, dir.path(), Path::new("README.md")).unwrap().0, want);
+    }
+
+    #[test]
+    fn runs_of_several_seeds_fold_into_their_mean_and_range() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = "model,model_triangles,method,method_name,metric,value
+m,10,\"nehab:clusters=64,seed=0\",nehab,ovr_mean,1.10
+m,10,\"nehab:clusters=64,seed=1\",nehab,ovr_mean,1.20
+m,10,sander07,sander07,ovr_mean,1.12
+";
+        std::fs::write(dir.path().join("s.csv"), csv).unwrap();
+        let text = "<!-- generated from s.csv: rows=model cols=method cells=ovr_mean digits=2 spread=seed -->\n<!-- end generated -->";
+        let fresh = refresh(text, dir.path(), Path::new("G.md")).unwrap().0;
+        assert!(fresh.contains("| m (10) | 1.15 (1.10–1.20) | 1.12 |"), "{fresh}");
     }
 
     #[test]
