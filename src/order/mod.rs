@@ -115,6 +115,7 @@ registry![
     mla,
     strips,
     hoppe,
+    hoppe_d3dx,
     tipsify,
     forsyth,
     kcache,
