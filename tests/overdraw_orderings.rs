@@ -181,3 +181,32 @@ fn sander07_overdraw_is_within_two_percent_of_meshopts() {
         assert!(ours <= 1.02 * theirs, "{name}: sander07 {ours}, meshopt-overdraw {theirs}");
     }
 }
+
+/// Nehab et al. 2006 §6 choose the cluster count by doubling "until the average overdraw stops
+/// improving consistently" (`select=doubling`): on the helix, whose twists need several clusters,
+/// the search must go past one cluster, stop at a power of two within its cap, and keep a mean
+/// overdraw no worse than one cluster's and within `STALL` of every larger count it tried.
+#[test]
+fn doubling_picks_a_power_of_two_past_which_overdraw_stops_improving() {
+    use triorder::measure::OverdrawSummary;
+    use triorder::order;
+    use triorder::order::nehab::STALL;
+    use triorder::raster::RasterBackend;
+    use triorder::raster::cpu::CpuRaster;
+    let mesh = generate("helix:2");
+    let cameras = ViewSet::Ico(42).cameras(Framing::of(&mesh.positions), 0);
+    let mean = |spec: &str| {
+        let method = order::resolve(spec, 0).unwrap();
+        let orders = method.ordering.order(&triorder::mesh::Scene::still(mesh.clone())).unwrap();
+        let one = orders.single().unwrap();
+        let counts = CpuRaster.count(&mesh.positions, &mesh.triangles_in_order(&one.order), &cameras, 96).unwrap();
+        (OverdrawSummary::of(&counts).unwrap().mean, one.starts.len() - 1, orders.iterations)
+    };
+    let (chosen, count, tried) = mean("nehab:select=doubling,clusters=64,views=42,res=96");
+    assert!(count.is_power_of_two() && (2..=64).contains(&count), "chose {count} clusters");
+    assert!(tried.is_some_and(|n| n >= 3), "tried {tried:?} counts");
+    let (single, _, _) = mean("nehab:clusters=1,views=42,res=96");
+    assert!(chosen <= single, "{chosen} against one cluster's {single}");
+    let (larger, _, _) = mean(&format!("nehab:clusters={},views=42,res=96", 2 * count));
+    assert!(chosen - larger < STALL, "{chosen} at {count}, {larger} at {}", 2 * count);
+}

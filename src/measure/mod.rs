@@ -60,6 +60,7 @@ pub static ORDERING: &[Name] = &[
         optimum: None,
     },
     Name { name: "iterations", label: "optimization iterations", needs: "a method that iterates", optimum: None },
+    Name { name: "clusters", label: "clusters in the order", needs: "a method that clusters", optimum: None },
     Name {
         name: "converged",
         label: "converged before the iteration cap (1) or not (0)",

@@ -148,6 +148,10 @@ impl Context {
         if buffers {
             rows.push(Row { metric: "buffers", value: orders.buffers.len() as f64, ..base.clone() });
         }
+        // The clusters a static order is made of (nehab's chosen count, sander07's patches).
+        if let Some(one) = orders.single().filter(|b| b.starts.len() > 2) {
+            rows.push(Row { metric: "clusters", value: (one.starts.len() - 1) as f64, ..base.clone() });
+        }
         if let Some(iterations) = orders.iterations {
             rows.push(Row { metric: "iterations", value: iterations as f64, ..base.clone() });
             rows.push(Row { metric: "converged", value: f64::from(u8::from(orders.converged)), ..base.clone() });
