@@ -14,8 +14,9 @@
 //! `clusters` as given. `select=doubling` is the paper's own rule (§6, with Fig. 9): "trying the
 //! method on successive powers of two, until the average overdraw stops improving consistently".
 //! We read "consistently" as two doublings in a row: the count k is taken when neither 2k nor 4k
-//! lowers the mean overdraw ratio over the graph's own views by [`STALL`] or more; `clusters` is
-//! then the largest count tried. The mean is counted exactly, on the CPU rasterizer, for each
+//! lowers the mean overdraw ratio over the graph's own views by [`STALL`] or more, once some
+//! doubling has (a mesh of several components gains nothing from its first doublings);
+//! `clusters` is the largest count tried. The mean is counted exactly, on the CPU rasterizer, for each
 //! count tried (the doubling costs a few times one run).
 
 pub mod feedback_arc_set;
@@ -138,9 +139,16 @@ impl Ordering for Nehab {
             tried.push((order, ovr));
             let n = tried.len();
             let stalled = |a: usize| tried[a].1 - tried[a + 1].1 < STALL;
-            if (n >= 3 && stalled(n - 3) && stalled(n - 2)) || k >= self.clusters {
-                // The first count whose next two doublings both stalled, else the last tried.
-                let pick = (0..n.saturating_sub(2)).find(|&i| stalled(i) && stalled(i + 1)).unwrap_or(n - 1);
+            // The first count whose next two doublings both stall, once the overdraw has started
+            // improving: the first doublings of a mesh of several components change nothing (a
+            // cluster per component), and stopping there would never try the knee.
+            let knee = || {
+                let improved = (0..n.saturating_sub(1)).find(|&i| !stalled(i))?;
+                (improved + 1..n.saturating_sub(2)).find(|&i| stalled(i) && stalled(i + 1))
+            };
+            if knee().is_some() || k >= self.clusters {
+                // Else (the cap reached first) the last count tried.
+                let pick = knee().unwrap_or(n - 1);
                 let mut orders = Orders::from(tried.swap_remove(pick).0);
                 orders.iterations = Some(n);
                 return Ok(orders);
