@@ -26,6 +26,8 @@
 //! - `percent=yes` (optional): shares written as percentages.
 //! - `spread` (optional): a method parameter (`seed`) whose runs fold into one cell, written as
 //!   their mean with the least and greatest in brackets.
+//! - `slope=N` (optional): each cell is instead the least-squares slope of log value against log
+//!   triangle count over its rows of at least N triangles (1: linear growth).
 //! - `best` (optional): `row` or `col` writes the lowest of each value of a cell across its row
 //!   or column in bold (lower is better for every metric we have); `input` never counts as best.
 //!
@@ -59,6 +61,9 @@ struct Recipe {
     /// A method parameter (`seed`) whose runs fold into one cell: their mean, then the least to
     /// the greatest in brackets.
     spread: Option<String>,
+    /// Each cell is the least-squares slope of log value against log triangle count over the
+    /// cell's rows of at least this many triangles (how an ordering's time grows).
+    slope: Option<u64>,
 }
 
 /// How numbers are written: fixed decimals, or significant digits (for times spanning orders of
@@ -103,6 +108,7 @@ impl Recipe {
             relative_to: None,
             percent: false,
             spread: None,
+            slope: None,
         };
         for option in options.split_whitespace() {
             let (key, value) = option.split_once('=').ok_or_else(|| format!("`{option}` is not KEY=VALUE"))?;
@@ -148,9 +154,12 @@ impl Recipe {
                 "relative_to" => recipe.relative_to = Some(value.to_string()),
                 "percent" => recipe.percent = value == "yes",
                 "spread" => recipe.spread = Some(value.to_string()),
+                "slope" => {
+                    recipe.slope = Some(value.parse().map_err(|_| format!("slope `{value}` is not a triangle count"))?)
+                }
                 _ => {
                     return Err(format!(
-                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent, spread)"
+                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent, spread, slope)"
                     ));
                 }
             }
@@ -181,6 +190,8 @@ impl Recipe {
         // (row, col, cell index) → value.
         let mut values: Vec<((usize, usize, usize), f64)> = Vec::new();
         let mut cond_at = filter_at + self.filter.len();
+        // With `slope`: (cell, ln triangles, ln value) of every row, fitted below.
+        let mut sloped: Vec<((usize, usize, usize), f64, f64)> = Vec::new();
         for (k, (metric, conds)) in self.cells.iter().enumerate() {
             for (mut cells, value) in table.rows(metric, &columns)? {
                 // A model is named by its full triangle count: the most any of its rows has
@@ -218,6 +229,13 @@ impl Recipe {
                 } else {
                     (index(&mut cols, &cells[n_rows..keys]), k)
                 };
+                if let Some(least) = self.slope {
+                    let triangles: f64 = cells[keys].parse().unwrap_or(0.0);
+                    if triangles >= least as f64 && value > 0.0 {
+                        sloped.push(((r, c, k), triangles.ln(), value.ln()));
+                    }
+                    continue;
+                }
                 if self.spread.is_none() && values.iter().any(|(key, _)| *key == (r, c, k)) {
                     return Err(Error::input(
                         &path,
@@ -233,6 +251,19 @@ impl Recipe {
                 values.push(((r, c, k), value));
             }
             cond_at += conds.len();
+        }
+        let mut cells_fitted: Vec<(usize, usize, usize)> = sloped.iter().map(|(key, _, _)| *key).collect();
+        cells_fitted.sort_unstable();
+        cells_fitted.dedup();
+        for key in cells_fitted {
+            let points: Vec<(f64, f64)> =
+                sloped.iter().filter(|(k, _, _)| *k == key).map(|&(_, x, y)| (x, y)).collect();
+            let n = points.len() as f64;
+            let (mx, my) = (points.iter().map(|p| p.0).sum::<f64>() / n, points.iter().map(|p| p.1).sum::<f64>() / n);
+            let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+            if points.len() >= 2 && sxx > 0.0 {
+                values.push((key, points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx));
+            }
         }
         if rows.is_empty() {
             return Err(Error::input(&path, "no rows match the gallery table's cells and filter"));
@@ -274,7 +305,8 @@ impl Recipe {
             // Cells are read in order, so their columns are too (a cell with no rows has none).
             let title = |key: &Vec<String>| {
                 let (metric, conds) = &self.cells[key[1].parse::<usize>().unwrap_or(0)];
-                cell_title(metric, conds)
+                let title = cell_title(metric, conds);
+                if self.slope.is_some() { format!("slope of log {title} on log triangles") } else { title }
             };
             (label(&row_parts, &rows), cols.iter().map(title).collect())
         } else {
@@ -456,6 +488,25 @@ m,10,sander07,sander07,ovr_mean,1.12
         let text = "<!-- generated from s.csv: rows=model cols=method cells=ovr_mean digits=2 spread=seed -->\n<!-- end generated -->";
         let fresh = refresh(text, dir.path(), Path::new("G.md")).unwrap().0;
         assert!(fresh.contains("| m (10) | 1.15 (1.10–1.20) | 1.12 |"), "{fresh}");
+    }
+
+    #[test]
+    fn slopes_fit_log_value_against_log_triangles() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = "model,model_triangles,method,method_name,metric,value
+a,1000,m,m,seconds,1.0
+a,1000,n,n,seconds,1.0
+b,4000,m,m,seconds,4.0
+b,4000,n,n,seconds,2.0
+c,16000,m,m,seconds,16.0
+c,16000,n,n,seconds,4.0
+d,100,m,m,seconds,50.0
+";
+        std::fs::write(dir.path().join("t.csv"), csv).unwrap();
+        let text = "<!-- generated from t.csv: rows=method cols=cells cells=seconds slope=1000 digits=2 -->\n<!-- end generated -->";
+        let fresh = refresh(text, dir.path(), Path::new("G.md")).unwrap().0;
+        // Linear in the triangles from 1,000 up; the 100-triangle row is left out.
+        assert!(fresh.contains("| m | 1.00 |") && fresh.contains("| n | 0.50 |"), "{fresh}");
     }
 
     #[test]
