@@ -79,6 +79,9 @@
 //! label = "metric:iterations"      # bar: write this metric of the same model and method above
 //!                                  # each bar instead of the bar's value
 //! view = [0, 0, 1]                 # sequence, corners: direction the model is seen from
+//! up = [0, 0, 1]                   # drawings: the world direction drawn upwards (default +y)
+//! spread = "seed"                  # bar, line, scatter: fold the runs of each seed into their
+//!                                  # mean, with whiskers from the least to the greatest
 //! highlight = ["cheap-cuts"]       # line, scatter with methods as series: these methods drawn
 //!                                  # last, with larger outlined markers; a line chart of more
 //!                                  # than 8 series draws the others as grey context
