@@ -305,7 +305,7 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &st
         Some((_, title)) => title.to_string(),
         None => figure.y_label.clone().unwrap_or(metric),
     };
-    if let Some(o) = optimum.filter(|&o| o == y.start) {
+    if let Some(o) = optimum.filter(|&o| o == y.start && extent.from_zero) {
         // Bars growing from the optimum: it is the axis itself, so it is named, not drawn.
         y_desc = format!("{y_desc} (bars from the optimum, {})", axes::number(o));
     }
