@@ -26,6 +26,8 @@
 //! - `percent=yes` (optional): shares written as percentages.
 //! - `spread` (optional): a method parameter (`seed`) whose runs fold into one cell, written as
 //!   their mean with the least and greatest in brackets.
+//! - `argmin=COLUMN` (optional): each cell is the lowest of its rows, written with that row's
+//!   COLUMN (`argmin=method_name`: which ordering wins, and its value).
 //! - `slope=N` (optional): each cell is instead the least-squares slope of log value against log
 //!   triangle count over its rows of at least N triangles (1: linear growth).
 //! - `best` (optional): `row` or `col` writes the lowest of each value of a cell across its row
@@ -64,6 +66,9 @@ struct Recipe {
     /// Each cell is the least-squares slope of log value against log triangle count over the
     /// cell's rows of at least this many triangles (how an ordering's time grows).
     slope: Option<u64>,
+    /// Each cell is the lowest of the cell's rows, named by this column (`method_name`): which
+    /// ordering wins there.
+    argmin: Option<String>,
 }
 
 /// How numbers are written: fixed decimals, or significant digits (for times spanning orders of
@@ -109,6 +114,7 @@ impl Recipe {
             percent: false,
             spread: None,
             slope: None,
+            argmin: None,
         };
         for option in options.split_whitespace() {
             let (key, value) = option.split_once('=').ok_or_else(|| format!("`{option}` is not KEY=VALUE"))?;
@@ -154,12 +160,13 @@ impl Recipe {
                 "relative_to" => recipe.relative_to = Some(value.to_string()),
                 "percent" => recipe.percent = value == "yes",
                 "spread" => recipe.spread = Some(value.to_string()),
+                "argmin" => recipe.argmin = Some(value.to_string()),
                 "slope" => {
                     recipe.slope = Some(value.parse().map_err(|_| format!("slope `{value}` is not a triangle count"))?)
                 }
                 _ => {
                     return Err(format!(
-                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent, spread, slope)"
+                        "unknown option `{key}` (rows, cols, cells, filter, digits, best, relative_to, percent, spread, slope, argmin)"
                     ));
                 }
             }
@@ -184,6 +191,12 @@ impl Recipe {
         columns.extend(self.filter.iter().map(|(c, _)| c.as_str()));
         columns.extend(self.cells.iter().flat_map(|(_, conds)| conds.iter().map(|(c, _)| c.as_str())));
         let filter_at = keys + 1;
+        // `argmin`: its column last, so the others keep their places.
+        if let Some(column) = &self.argmin {
+            columns.push(column.as_str());
+        }
+        let named_at = columns.len() - 1;
+        let mut named: Vec<((usize, usize, usize), f64, String)> = Vec::new();
 
         let (mut rows, mut cols): (Vec<Vec<String>>, Vec<Vec<String>>) = (Vec::new(), Vec::new());
         let mut triangles: Vec<(String, u64)> = Vec::new();
@@ -229,6 +242,10 @@ impl Recipe {
                 } else {
                     (index(&mut cols, &cells[n_rows..keys]), k)
                 };
+                if self.argmin.is_some() {
+                    named.push(((r, c, k), value, cells[named_at].clone()));
+                    continue;
+                }
                 if let Some(least) = self.slope {
                     let triangles: f64 = cells[keys].parse().unwrap_or(0.0);
                     if triangles >= least as f64 && value > 0.0 {
@@ -251,6 +268,15 @@ impl Recipe {
                 values.push(((r, c, k), value));
             }
             cond_at += conds.len();
+        }
+        // With `argmin`: the lowest of each cell's rows, and whose it is.
+        let mut winners: Vec<((usize, usize, usize), String)> = Vec::new();
+        for (key, value, name) in &named {
+            let lowest = named.iter().filter(|(k, _, _)| k == key).all(|(_, v, _)| value <= v);
+            if lowest && !winners.iter().any(|(k, _)| k == key) {
+                winners.push((*key, name.clone()));
+                values.push((*key, *value));
+            }
         }
         let mut cells_fitted: Vec<(usize, usize, usize)> = sloped.iter().map(|(key, _, _)| *key).collect();
         cells_fitted.sort_unstable();
@@ -372,6 +398,10 @@ impl Recipe {
                             None => "–".to_string(),
                             Some(v) => {
                                 let text = format!("{}{suffix}", digits.write(v * scale));
+                                let text = match winners.iter().find(|(key, _)| *key == (r, c, k)) {
+                                    Some((_, name)) => format!("{name} {text}"),
+                                    None => text,
+                                };
                                 let text = if best(r, c, k) { format!("**{text}**") } else { text };
                                 match range(r, c, k).filter(|_| reference.is_none()) {
                                     Some((lo, hi)) => {
@@ -488,6 +518,17 @@ m,10,sander07,sander07,ovr_mean,1.12
         let text = "<!-- generated from s.csv: rows=model cols=method cells=ovr_mean digits=2 spread=seed -->\n<!-- end generated -->";
         let fresh = refresh(text, dir.path(), Path::new("G.md")).unwrap().0;
         assert!(fresh.contains("| m (10) | 1.15 (1.10–1.20) | 1.12 |"), "{fresh}");
+    }
+
+    #[test]
+    fn argmin_names_the_lowest_row_of_each_cell() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("results")).unwrap();
+        std::fs::write(dir.path().join("results/x.csv"), CSV).unwrap();
+        let text = "<!-- generated from results/x.csv: rows=model cols=cache_size cells=acmr argmin=method_name digits=2 -->\n<!-- end generated -->";
+        let fresh = refresh(text, dir.path(), Path::new("G.md")).unwrap().0;
+        assert!(fresh.contains("| a.ply (100) | hoppe 0.60 | hoppe 0.55 |"), "{fresh}");
+        assert!(fresh.contains("| b.ply (2,000) | input 0.50 | – |"), "{fresh}");
     }
 
     #[test]
