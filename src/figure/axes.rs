@@ -435,6 +435,17 @@ pub fn number(v: f64) -> String {
     if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
 }
 
+/// `v` with `digits` significant digits in plain decimals, never e-notation (`0.0000123`,
+/// `1.23`), for tables whose numbers are read side by side.
+pub fn significant(v: f64, digits: usize) -> String {
+    let decimals = if v == 0.0 || !v.is_finite() {
+        0
+    } else {
+        (digits as i32 - 1 - v.abs().log10().floor() as i32).clamp(0, 12) as usize
+    };
+    format!("{v:.decimals$}")
+}
+
 /// Splits `text` into lines of at most `max` characters at spaces.
 pub fn wrap(text: &str, max: usize) -> Vec<String> {
     let mut lines: Vec<String> = Vec::new();

@@ -81,13 +81,12 @@ enum Digits {
 
 impl Digits {
     fn write(self, v: f64) -> String {
-        let decimals = match self {
-            Digits::Decimals(d) => d,
+        match self {
+            Digits::Decimals(d) => format!("{v:.d$}"),
             // Counts (rounds, buffers) are whole numbers: written whole.
-            Digits::Significant(_) if v == 0.0 || !v.is_finite() || v.fract() == 0.0 => 0,
-            Digits::Significant(n) => (n as i32 - 1 - v.abs().log10().floor() as i32).clamp(0, 12) as usize,
-        };
-        format!("{v:.decimals$}")
+            Digits::Significant(_) if v.fract() == 0.0 => format!("{v:.0}"),
+            Digits::Significant(n) => super::axes::significant(v, n),
+        }
     }
 }
 

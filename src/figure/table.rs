@@ -150,10 +150,7 @@ impl Format {
         match self {
             Format::Fixed(decimals) => format!("{v:.decimals$}"),
             Format::Each if v == 0.0 || !v.is_finite() => axes::number(v),
-            Format::Each => {
-                let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
-                format!("{v:.decimals$}")
-            }
+            Format::Each => axes::significant(v, 4),
         }
     }
 }
