@@ -6,6 +6,7 @@
 
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::axes::{self, Area, Colors, DrawResult, FONT, Frame, Painter, Swatch};
 use super::data::Panel;
@@ -69,8 +70,50 @@ impl Kind for Distribution {
         Swatch::Line
     }
 
+    /// The lines of statistics under each panel name the series with their colours: no legend.
+    fn legend(&self) -> bool {
+        false
+    }
+
+    /// The usual panel, taller by a line of statistics per series.
+    fn panel_size(&self) -> Option<(usize, usize)> {
+        let (w, h) = if self.panels.len() == 1 { (760, 500) } else { (540, 400) };
+        Some((w, h + self.stats_height() as usize))
+    }
+
     fn draw(&self, index: usize, area: &Area, title: &str, frame: &Frame, colors: &Colors) -> DrawResult {
-        axes::panel(area, title, frame, &DistributionPainter { series: &self.panels[index], colors })
+        let series = &self.panels[index];
+        let (plot, stats) = area.split_vertically(area.dim_in_pixel().1.saturating_sub(self.stats_height()));
+        axes::panel(&plot, title, frame, &DistributionPainter { series, colors })?;
+        let style = TextStyle::from((FONT, 12)).pos(Pos::new(HPos::Left, VPos::Center));
+        for (k, s) in series.iter().enumerate() {
+            let y = (k as u32 * STATS_ROW + STATS_ROW / 2) as i32;
+            let color = colors.of(&s.name);
+            stats.draw(&PathElement::new(vec![(STATS_LEFT, y), (STATS_LEFT + 24, y)], color.stroke_width(3)))?;
+            let text = format!(
+                "{}: mean {} (dashed), max {}, variance {} (n = {})",
+                s.name,
+                axes::number(s.mean),
+                axes::number(s.max),
+                axes::significant(s.variance, 4),
+                s.values.len()
+            );
+            stats.draw(&Text::new(text, (STATS_LEFT + 32, y), style.clone()))?;
+        }
+        Ok(())
+    }
+}
+
+/// Height of one series' line of statistics under a panel.
+const STATS_ROW: u32 = 17;
+
+/// Where the statistics start: under the y axis' labels.
+const STATS_LEFT: i32 = 20;
+
+impl Distribution {
+    /// Height of the statistics under each panel: a line for each series of the fullest panel.
+    fn stats_height(&self) -> u32 {
+        self.panels.iter().map(Vec::len).max().unwrap_or(0) as u32 * STATS_ROW + 6
     }
 }
 
@@ -89,26 +132,9 @@ impl Painter for DistributionPainter<'_> {
             let color = self.colors.of(&s.name);
             let n = s.values.len() as f64;
             let curve = s.values.iter().enumerate().map(|(i, &v)| (100.0 * (i as f64 + 0.5) / n, v));
-            let stats = format!(
-                "{}: mean {}, max {}, variance {} (n = {})",
-                s.name,
-                axes::number(s.mean),
-                axes::number(s.max),
-                axes::number(s.variance),
-                s.values.len()
-            );
-            chart
-                .draw_series(LineSeries::new(curve, color.stroke_width(2)))?
-                .label(stats)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
+            chart.draw_series(LineSeries::new(curve, color.stroke_width(2)))?;
             chart.draw_series(DashedLineSeries::new([(0.0, s.mean), (100.0, s.mean)], 6, 4, color.stroke_width(1)))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 12))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.3))
-            .draw()
+        Ok(())
     }
 }

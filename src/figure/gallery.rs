@@ -33,6 +33,8 @@
 //! - `best` (optional): `row` or `col` writes the lowest of each value of a cell across its row
 //!   or column in bold (lower is better for every metric we have); `input` never counts as best.
 //!
+//! A recipe with `checks=` is a table of targets met instead ([`super::verdicts`]).
+//!
 //! `triorder gallery` rewrites every such table from its CSV; `tests/gallery.rs` fails when one
 //! differs from what its CSV gives, so a rerun that moves a number cannot leave the text behind.
 
@@ -40,6 +42,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::data::{Table, display_names};
+use super::verdicts::Verdicts;
 use crate::error::{Error, Result};
 
 const OPEN: &str = "<!-- generated from ";
@@ -441,6 +444,12 @@ fn cell_title(metric: &str, conditions: &[(String, String)]) -> String {
         .join(" ")
 }
 
+/// A generated table's recipe: a table of numbers, or of targets met.
+enum Generated {
+    Numbers(Recipe),
+    Verdicts(Verdicts),
+}
+
 /// `markdown` with every generated table rewritten from its CSV under `root` (the project root),
 /// and the CSVs they came from. An unclosed table or a bad recipe is an error naming `file`.
 pub fn refresh(markdown: &str, root: &Path, file: &Path) -> Result<(String, Vec<String>)> {
@@ -453,18 +462,27 @@ pub fn refresh(markdown: &str, root: &Path, file: &Path) -> Result<(String, Vec<
         let head_end = rest[at..].find("-->").ok_or_else(|| {
             Error::input(file.display(), format!("line {line}: a generated table's comment is not closed"))
         })? + at;
-        let recipe = Recipe::parse(&rest[at + OPEN.len()..head_end])
-            .map_err(|e| Error::input(file.display(), format!("line {line}: {e}")))?;
+        let text = &rest[at + OPEN.len()..head_end];
+        let at_line = |e: String| Error::input(file.display(), format!("line {line}: {e}"));
+        let recipe = if Verdicts::wanted(text) {
+            Generated::Verdicts(Verdicts::parse(text).map_err(at_line)?)
+        } else {
+            Generated::Numbers(Recipe::parse(text).map_err(at_line)?)
+        };
         let body_start = head_end + 3;
         let close = rest[body_start..]
             .find(CLOSE)
             .ok_or_else(|| Error::input(file.display(), format!("line {line}: a generated table has no `{CLOSE}`")))?
             + body_start;
+        let (csv, table) = match recipe {
+            Generated::Numbers(recipe) => (recipe.csv.clone(), recipe.table(root)?),
+            Generated::Verdicts(verdicts) => (verdicts.csv.clone(), verdicts.table(root)?),
+        };
         out.push_str(&rest[..body_start]);
         out.push('\n');
-        out.push_str(&recipe.table(root)?);
+        out.push_str(&table);
         out.push_str(CLOSE);
-        sources.push(recipe.csv);
+        sources.push(csv);
         rest = &rest[close + CLOSE.len()..];
     }
     out.push_str(rest);

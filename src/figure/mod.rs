@@ -17,6 +17,7 @@ mod hardware_fit;
 mod ratio;
 pub mod spec;
 mod table;
+mod verdicts;
 mod xy;
 
 use std::ops::Range;
