@@ -25,8 +25,8 @@ fn every_generated_table_matches_its_csv() {
     }
 }
 
-/// The numbers the gallery's prose quotes to two to four decimals are measurements: each must
-/// be a value, rounded as written, of a CSV its section names (the spec ids in backticks in the
+/// The numbers the gallery's prose quotes to one to four decimals are measurements: each must
+/// be a value, rounded as written (a percentage may quote a share: `23.1%` for 0.231), of a CSV its section names (the spec ids in backticks in the
 /// `##` and `###` headings above it, every `results/ID.csv` the `##` section links, and the ids a
 /// line adds with `<!-- also: ID … -->`). So a rerun that moves a number fails here until the text
 /// follows. Exempt: the paper's own numbers (a paragraph starting `**Paper`, and a table right
@@ -88,7 +88,18 @@ fn numbers_quoted_in_the_gallery_are_values_of_their_csvs() {
         values.sort_by(f64::total_cmp);
         for number in decimal_numbers(line) {
             checked += 1;
-            if !measured(&values, number) {
+            // A percentage may quote a share (0.231 written 23.1%).
+            let share = || {
+                let after = &line[line.find(number).map_or(0, |at| at + number.len())..];
+                let decimals = number.split('.').nth(1).map_or(0, str::len);
+                let v = number.parse::<f64>().expect("digits") / 100.0;
+                // `23.1%`, or the first of a range `26.9–27.5%`.
+                let range_end =
+                    after.strip_prefix('–').map(|r| r.trim_start_matches(|c: char| c.is_ascii_digit() || c == '.'));
+                (after.starts_with('%') || range_end.is_some_and(|r| r.starts_with('%')))
+                    && measured(&values, &format!("{v:.prec$}", prec = decimals + 2))
+            };
+            if !measured(&values, number) && !share() {
                 stray.push(format!("line {}: {number} not in {scope:?}: `{}`", n + 1, line.trim()));
             }
         }
@@ -121,7 +132,7 @@ fn linked_results(line: &str) -> Vec<String> {
         .collect()
 }
 
-/// The numbers with two to four decimals in `line`, as written (`0.633`, `1.0913`), not parts
+/// The numbers with one to four decimals in `line`, as written (`0.633`, `1.0913`), not parts
 /// of longer tokens (versions, commits, `1.2.3`).
 fn decimal_numbers(line: &str) -> Vec<&str> {
     let bytes = line.as_bytes();
@@ -140,7 +151,7 @@ fn decimal_numbers(line: &str) -> Vec<&str> {
                 i += 1;
             }
             let decimals = i - dot - 1;
-            if (2..=4).contains(&decimals) && (i == bytes.len() || !glued(bytes[i])) {
+            if (1..=4).contains(&decimals) && (i == bytes.len() || !glued(bytes[i])) {
                 found.push(&line[start..i]);
             }
         }
@@ -152,7 +163,7 @@ fn decimal_numbers(line: &str) -> Vec<&str> {
 #[test]
 fn decimal_numbers_are_found_as_written() {
     assert_eq!(
-        decimal_numbers("ACMR 0.633 vs 1.0913 and 12.34, not v1.2.3, 1.5 or a1.234"),
-        ["0.633", "1.0913", "12.34"]
+        decimal_numbers("ACMR 0.633 vs 1.0913 and 12.34, 1.5 s, not v1.2.3, 1.23456 or a1.234"),
+        ["0.633", "1.0913", "12.34", "1.5"]
     );
 }
