@@ -234,6 +234,10 @@ struct State<'a> {
     place_score: Vec<f32>,
     /// Valence boost for each live count.
     live_score: Vec<f32>,
+    /// Each vertex's place score plus its valence; current for every vertex with live triangles.
+    /// Apart from [`Vertex`]: the candidates' scores are summed from it, and densely packed, the
+    /// vertices near the cache share cache lines.
+    score: Vec<f32>,
     cache: usize,
     /// The cached vertices that have live triangles, front first, and the list being built, with
     /// explicit lengths: at most `cache` entries plus the three a triangle can push out.
@@ -259,8 +263,6 @@ struct Vertex {
     live: u32,
     /// The valence part of its score; it changes only when one of its triangles is drawn.
     valence: f32,
-    /// Its place score plus `valence`; current for every vertex with live triangles.
-    score: f32,
 }
 
 impl<'a> State<'a> {
@@ -268,13 +270,11 @@ impl<'a> State<'a> {
         let offsets = vertex_triangles.offsets();
         let max_live = offsets.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0) as usize;
         let live_score: Vec<f32> = (0..=max_live).map(|l| scores.boost(l.max(1))).collect();
-        let vertices = offsets
+        let vertices: Vec<Vertex> = offsets
             .windows(2)
-            .map(|w| {
-                let valence = live_score[(w[1] - w[0]) as usize];
-                Vertex { start: w[0], live: w[1] - w[0], valence, score: valence }
-            })
+            .map(|w| Vertex { start: w[0], live: w[1] - w[0], valence: live_score[(w[1] - w[0]) as usize] })
             .collect();
+        let score = vertices.iter().map(|v| v.valence).collect();
         State {
             triangles,
             adjacent: vertex_triangles.items().to_vec(),
@@ -282,6 +282,7 @@ impl<'a> State<'a> {
             emitted: vec![false; triangles.len()],
             place_score: scores.places(cache),
             live_score,
+            score,
             cache,
             lru: vec![Entry::default(); cache + 3],
             lru_len: 0,
@@ -292,7 +293,7 @@ impl<'a> State<'a> {
 
     /// The score of live triangle `t`.
     fn score(&self, t: u32) -> f32 {
-        self.triangles[t as usize].iter().map(|&v| self.vertices[v as usize].score).sum()
+        self.triangles[t as usize].iter().map(|&v| self.score[v as usize]).sum()
     }
 
     /// The best-scoring live triangle of vertex `v` (the first on ties).
@@ -300,8 +301,7 @@ impl<'a> State<'a> {
         let Vertex { start, live, .. } = self.vertices[v as usize];
         let row = &self.adjacent[start as usize..(start + live) as usize];
         row.iter()
-            .copied()
-            .fold((NONE, f32::NEG_INFINITY), |best, t| {
+            .fold((NONE, f32::NEG_INFINITY), |best, &t| {
                 let score = self.score(t);
                 if score > best.1 { (t, score) } else { best }
             })
@@ -314,7 +314,10 @@ impl<'a> State<'a> {
         for v in self.triangles[t as usize] {
             let vertex = &mut self.vertices[v as usize];
             let live_part = &mut self.adjacent[vertex.start as usize..(vertex.start + vertex.live) as usize];
-            if let Some(at) = live_part.iter().position(|&u| u == t) {
+            // The whole row is scanned rather than stopping at `t`: where `t` sits is data, and
+            // a row is a handful of entries, fewer than a mispredicted exit costs.
+            let at = live_part.iter().enumerate().fold(usize::MAX, |at, (i, u)| if *u == t { i } else { at });
+            if at != usize::MAX {
                 live_part.swap(at, live_part.len() - 1);
                 vertex.live -= 1;
                 vertex.valence = self.live_score[vertex.live as usize];
@@ -334,7 +337,7 @@ impl<'a> State<'a> {
     /// loops get the registers.
     #[inline(never)]
     fn rescore(&mut self, drawn: u32) -> u32 {
-        let State { triangles, adjacent, vertices, place_score, lru, next, .. } = self;
+        let State { triangles, adjacent, vertices, place_score, score, lru, next, .. } = self;
         let [a, b, c] = triangles[drawn as usize];
         let distinct = [true, b != a, c != a && c != b];
         let k = distinct.iter().filter(|&&d| d).count() as u32;
@@ -355,16 +358,15 @@ impl<'a> State<'a> {
         }
         self.next_len = len;
         for &Entry { vertex, place } in &next[..len] {
-            let vertex = &mut vertices[vertex as usize];
-            vertex.score = place_score[place as usize] + vertex.valence;
+            score[vertex as usize] = place_score[place as usize] + vertices[vertex as usize].valence;
         }
         let (mut best, mut best_score) = (NONE, f32::NEG_INFINITY);
         for &Entry { vertex, .. } in &next[..len] {
             let Vertex { start, live, .. } = vertices[vertex as usize];
             for &t in &adjacent[start as usize..(start + live) as usize] {
-                let score = triangles[t as usize].iter().map(|&v| vertices[v as usize].score).sum::<f32>();
-                if score > best_score {
-                    best_score = score;
+                let sum = triangles[t as usize].iter().map(|&v| score[v as usize]).sum::<f32>();
+                if sum > best_score {
+                    best_score = sum;
                     best = t;
                 }
             }
@@ -374,8 +376,12 @@ impl<'a> State<'a> {
 
     /// The entries the last [`State::rescore`] pushed out of the cache (the list's tail).
     fn evicted(&self) -> &[Entry] {
+        // A step moves an entry back by at most three places, so at most the last three can
+        // have passed `cache`; counted without a search.
         let listed = &self.next[..self.next_len];
-        &listed[listed.partition_point(|e| (e.place as usize) < self.cache)..]
+        let tail = &listed[listed.len().saturating_sub(3)..];
+        let out = tail.iter().filter(|e| e.place as usize >= self.cache).count();
+        &listed[listed.len() - out..]
     }
 
     /// Makes the LRU built by [`State::rescore`] the current one, less the entries pushed out.

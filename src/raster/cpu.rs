@@ -222,7 +222,26 @@ struct Edge {
     step_y: i64,
 }
 
+/// Boxes at least this many pixels wide (less one) are drawn a row's run at a time, solved
+/// from the edge functions with three divisions, rather than testing every pixel of the box:
+/// there the tests outside the triangle and the mispredicted branches at its borders cost more.
+const SPAN_FROM: i64 = 4;
+
 impl Edge {
+    /// The pixel steps `k` from the row's start where `row + k·step_x ≥ 0`, as an inclusive
+    /// range (empty when the first exceeds the second): exactly the pixels the per-pixel test
+    /// passes.
+    fn inside(&self) -> (i64, i64) {
+        match self.step_x {
+            // k ≥ ⌈−row / step⌉
+            s if s > 0 => (-self.row.div_euclid(s), i64::MAX),
+            // k ≤ ⌊row / −step⌋
+            s if s < 0 => (i64::MIN, self.row.div_euclid(-s)),
+            _ if self.row >= 0 => (i64::MIN, i64::MAX),
+            _ => (1, 0),
+        }
+    }
+
     fn new(a: ScreenVertex, b: ScreenVertex, px: i64, py: i64) -> Edge {
         let (dx, dy) = (i64::from(b.x - a.x), i64::from(b.y - a.y));
         // y up: a top edge runs right-to-left horizontally; a left edge runs downward.
@@ -279,25 +298,38 @@ fn draw(
         let dzdy = ((dz2 * abx as f64 - dz1 * acx as f64) * inv_area * ONE as f64) as f32;
         // Offsets from vertex a stay small, so f32 keeps the plane accurate.
         let (ax, ay) = (a.x as f32 / ONE as f32, a.y as f32 / ONE as f32);
+        let wide = x1 - x0 >= SPAN_FROM;
         for y in y0..=y1 {
-            let (mut e0, mut e1, mut e2) = (edges[0].row, edges[1].row, edges[2].row);
             let row = y as usize * n;
             let zy = a.z + dzdy * (y as f32 + 0.5 - ay);
-            for x in x0..=x1 {
-                if (e0 | e1 | e2) >= 0 {
-                    let z = zy + dzdx * (x as f32 + 0.5 - ax);
-                    let d = &mut depth[row + x as usize];
-                    let passed = z < *d;
-                    if passed {
-                        counts.covered += u64::from(*d == 1.0);
-                        *d = z;
-                        counts.passed += 1;
-                    }
-                    on_fragment(Fragment { pixel: (row + x as usize) as u32, triangle: t as u32, depth: z, passed });
+            let mut fragment = |x: i64| {
+                let z = zy + dzdx * (x as f32 + 0.5 - ax);
+                let d = &mut depth[row + x as usize];
+                let passed = z < *d;
+                if passed {
+                    counts.covered += u64::from(*d == 1.0);
+                    *d = z;
+                    counts.passed += 1;
                 }
-                e0 += edges[0].step_x;
-                e1 += edges[1].step_x;
-                e2 += edges[2].step_x;
+                on_fragment(Fragment { pixel: (row + x as usize) as u32, triangle: t as u32, depth: z, passed });
+            };
+            if wide {
+                // The row's run of inside pixels, solved from the edge functions: no test per pixel.
+                let (lo, hi) = edges.iter().fold((0, x1 - x0), |(lo, hi), e| {
+                    let (from, to) = e.inside();
+                    (lo.max(from), hi.min(to))
+                });
+                (x0 + lo..=x0 + hi).for_each(&mut fragment);
+            } else {
+                let (mut e0, mut e1, mut e2) = (edges[0].row, edges[1].row, edges[2].row);
+                for x in x0..=x1 {
+                    if (e0 | e1 | e2) >= 0 {
+                        fragment(x);
+                    }
+                    e0 += edges[0].step_x;
+                    e1 += edges[1].step_x;
+                    e2 += edges[2].step_x;
+                }
             }
             for e in &mut edges {
                 e.row += e.step_y;
