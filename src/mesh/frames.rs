@@ -17,7 +17,7 @@
 
 use std::ops::Range;
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec3A};
 use rayon::prelude::*;
 
 use super::Mesh;
@@ -49,10 +49,22 @@ impl Framing {
 
     /// The corners of the bounding box of `positions` (zero for none).
     pub fn bounds_of(positions: &[Vec3]) -> (DVec3, DVec3) {
-        let (lo, hi) = positions
-            .iter()
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        if positions.is_empty() { (DVec3::ZERO, DVec3::ZERO) } else { (lo.as_dvec3(), hi.as_dvec3()) }
+        // In four SIMD lanes of running bounds, so that no vertex waits on the one before.
+        let (mut lo, mut hi) = ([Vec3A::INFINITY; 4], [Vec3A::NEG_INFINITY; 4]);
+        let mut quads = positions.chunks_exact(4);
+        for quad in &mut quads {
+            for ((lo, hi), &p) in lo.iter_mut().zip(&mut hi).zip(quad) {
+                (*lo, *hi) = (lo.min(p.into()), hi.max(p.into()));
+            }
+        }
+        for &p in quads.remainder() {
+            (lo[0], hi[0]) = (lo[0].min(p.into()), hi[0].max(p.into()));
+        }
+        let (lo, hi) = (lo.into_iter().reduce(Vec3A::min), hi.into_iter().reduce(Vec3A::max));
+        match (positions.is_empty(), lo, hi) {
+            (false, Some(lo), Some(hi)) => (lo.as_dvec3(), hi.as_dvec3()),
+            _ => (DVec3::ZERO, DVec3::ZERO),
+        }
     }
 
     /// The unit frame itself: positions already centred and of radius 1 map to themselves.
