@@ -60,11 +60,9 @@ impl Framing {
         for &p in quads.remainder() {
             (lo[0], hi[0]) = (lo[0].min(p.into()), hi[0].max(p.into()));
         }
-        let (lo, hi) = (lo.into_iter().reduce(Vec3A::min), hi.into_iter().reduce(Vec3A::max));
-        match (positions.is_empty(), lo, hi) {
-            (false, Some(lo), Some(hi)) => (lo.as_dvec3(), hi.as_dvec3()),
-            _ => (DVec3::ZERO, DVec3::ZERO),
-        }
+        let (lo, hi) =
+            (lo.into_iter().fold(Vec3A::INFINITY, Vec3A::min), hi.into_iter().fold(Vec3A::NEG_INFINITY, Vec3A::max));
+        if positions.is_empty() { (DVec3::ZERO, DVec3::ZERO) } else { (lo.as_dvec3(), hi.as_dvec3()) }
     }
 
     /// The unit frame itself: positions already centred and of radius 1 map to themselves.
