@@ -338,3 +338,31 @@ fn draw(
     }
     counts
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The run `Edge::inside` solves is exactly the pixels the per-pixel test passes, for edges
+    /// in every direction, through and beside pixel centres.
+    #[test]
+    fn an_edges_inside_run_is_what_the_pixel_test_passes() {
+        let vertex = |x: i32, y: i32| ScreenVertex { x, y, z: 0.5 };
+        let points = [(0, 0), (37 * ONE as i32 / 3, 5), (-300, 2_000), (4_000, -77), (ONE as i32 * 9, ONE as i32 * 9)];
+        let mut checked = 0;
+        for &(ax, ay) in &points {
+            for &(bx, by) in &points {
+                for (px, py) in [(HALF, HALF), (3 * ONE + HALF, HALF), (-2 * ONE + HALF, 7 * ONE + HALF)] {
+                    let edge = Edge::new(vertex(ax, ay), vertex(bx, by), px, py);
+                    let (from, to) = edge.inside();
+                    for k in -40i64..40 {
+                        let passes = edge.row + k * edge.step_x >= 0;
+                        assert_eq!(passes, (from..=to).contains(&k), "edge {ax},{ay} → {bx},{by}, step {k}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, points.len() * points.len() * 3 * 80);
+    }
+}
