@@ -16,7 +16,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::PathBuf;
 
 use glam::{DVec3, Mat4, Quat, Vec3};
-use triorder::measure::{MeasureOptions, measure};
+use triorder::measure::{MeasureOptions, measure, measure_many};
 use triorder::mesh::gltf::animation::{ClipSelection, read_animated, read_with_rest_pose};
 use triorder::mesh::{Frames, Framing, Mesh, Scene};
 use triorder::order::{self, Lookup, Orders, check_permutation};
@@ -178,6 +178,36 @@ fn mean_ovr(scene: &Scene, nodes: &Orders, views: u32, seed: u64) -> f64 {
     let measured = measure(scene, nodes, &options, &CpuRaster).unwrap();
     let values = measured.iter().flat_map(|m| &m.values);
     values.filter(|v| v.metric == "ovr_mean" && v.is_summary()).map(|v| v.value).next().expect("the views see the mesh")
+}
+
+/// Measuring several methods' orders of one animation together (each view of each frame
+/// rasterized once, every order's depth test replayed) gives every value that measuring each on
+/// its own gives: per clip, per view, with one buffer, one per frame and a lookup per view.
+#[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
+fn measuring_orders_together_gives_each_ones_values() {
+    let scene = animation("Fox.glb", None, 2);
+    assert!(scene.frames.clips.len() >= 2, "per-clip values are compared too");
+    let orders: Vec<Orders> = ["tipsify", "tipsify-per-frame", "hs17:views=12,res=32", "random"]
+        .iter()
+        .map(|spec| order::run(&order::resolve(spec, 3).unwrap(), &scene).unwrap())
+        .collect();
+    let options = MeasureOptions {
+        caches: vec!["fifo:16".parse().unwrap()],
+        views: Some(ViewSet::Random(24)),
+        res: 64,
+        ..Default::default()
+    };
+    let each: Vec<_> = orders.iter().map(|o| measure(&scene, o, &options, &CpuRaster).unwrap()).collect();
+    let refs: Vec<&Orders> = orders.iter().collect();
+    let together = measure_many(&scene, &refs, &options, &CpuRaster).unwrap();
+    assert_eq!(together.len(), each.len());
+    for (all, one) in together.iter().zip(&each) {
+        let values = |m: &[triorder::measure::Measured]| m.iter().flat_map(|m| m.values.clone()).collect::<Vec<_>>();
+        let (all, one) = (values(all), values(one));
+        assert!(one.iter().filter(|v| v.metric == "ovr").count() > 24, "per-view ratios of several frames");
+        assert_eq!(all, one);
+    }
 }
 
 /// A static mesh is an animation of one frame; hs17 then clusters viewpoints only. On meshes

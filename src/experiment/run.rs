@@ -23,7 +23,7 @@ use crate::figure::spec::FigureKind;
 use crate::measure::{self, Evaluation, cache};
 use crate::mesh::progressive::Update;
 use crate::mesh::{Mesh, Scene, source};
-use crate::order::{self, Clustered, Resolved};
+use crate::order::{self, Clustered, Orders, Resolved};
 use crate::raster::{cpu, views};
 use crate::results::{COLUMNS, Context, ORDER_COLUMNS, OrderRow, Row};
 
@@ -193,7 +193,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         None => spec.id.clone(),
     });
     let mut rows: Vec<(usize, Row)> = Vec::new();
-    let mut orders: Vec<(usize, OrderRow)> = Vec::new();
+    let mut orders_rows: Vec<(usize, OrderRow)> = Vec::new();
     let mut failures: Vec<Failure> = Vec::new();
     let per_model = plan.updates.len() * plan.methods.len();
     for (m, model) in plan.models.iter().enumerate() {
@@ -217,30 +217,58 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
             Err(e) => return Err(e),
         };
         let mut scene = scene;
-        for u in todo {
-            let unit = plan.units[u];
-            let method = &plan.methods[unit.method];
-            scene.set_update(plan.updates[unit.update]);
-            bar.set_message(format!("{} · {}", model.name, method.canonical()));
-            let measured = measure::evaluate(&scene, method, &options, raster.as_ref()).and_then(|evaluation| {
-                let buffers = per_node || scene.frames.is_animation();
-                let drawn =
-                    if draws { drawn(spec, &model.name, &scene, &evaluation, &options.caches)? } else { Vec::new() };
-                Ok((context.rows(&model.name, &model.source, &scene, &evaluation, buffers), drawn))
-            });
-            match measured {
-                Ok((new_rows, drawn)) => {
-                    rows.extend(new_rows.into_iter().map(|r| (u, r)));
-                    orders.extend(drawn.into_iter().map(|o| (u, o)));
+        // The methods of one update are ordered one by one, then measured together, so that the
+        // work every order shares (each view rasterized once for overdraw) is done once.
+        for batch in todo.chunk_by(|&a, &b| plan.units[a].update == plan.units[b].update) {
+            scene.set_update(plan.updates[plan.units[batch[0]].update]);
+            let mut ordered: Vec<(usize, measure::Evaluation)> = Vec::new();
+            for &u in batch {
+                let method = &plan.methods[plan.units[u].method];
+                bar.set_message(format!("{} · {}", model.name, method.canonical()));
+                match measure::order_timed(&scene, method, &options) {
+                    Ok(evaluation) => ordered.push((u, evaluation)),
+                    Err(e) if recorded(&e) => {
+                        let reason = e.to_string();
+                        rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
+                        failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
+                        bar.inc(1);
+                    }
+                    Err(e) => return Err(e),
                 }
-                Err(e) if recorded(&e) => {
-                    let reason = e.to_string();
-                    rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
-                    failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
-                }
-                Err(e) => return Err(e),
             }
-            bar.inc(1);
+            bar.set_message(format!("{}: measuring {} orders", model.name, ordered.len()));
+            let orders: Vec<&Orders> = ordered.iter().map(|(_, e)| &e.orders).collect();
+            // Measured together, or where that fails, one by one, so a failure is the method's.
+            let together = measure::measure_many(&scene, &orders, &options, raster.as_ref());
+            let mut together = together.map(|m| m.into_iter().map(Ok).collect::<Vec<_>>()).unwrap_or_else(|_| {
+                orders.iter().map(|o| measure::measure(&scene, o, &options, raster.as_ref())).collect()
+            });
+            for ((u, mut evaluation), measured) in ordered.into_iter().zip(together.drain(..)) {
+                let method = &plan.methods[plan.units[u].method];
+                let result = measured.and_then(|measured| {
+                    evaluation.measured = measured;
+                    let buffers = per_node || scene.frames.is_animation();
+                    let drawn = if draws {
+                        drawn(spec, &model.name, &scene, &evaluation, &options.caches)?
+                    } else {
+                        Vec::new()
+                    };
+                    Ok((context.rows(&model.name, &model.source, &scene, &evaluation, buffers), drawn))
+                });
+                match result {
+                    Ok((new_rows, drawn)) => {
+                        rows.extend(new_rows.into_iter().map(|r| (u, r)));
+                        orders_rows.extend(drawn.into_iter().map(|o| (u, o)));
+                    }
+                    Err(e) if recorded(&e) => {
+                        let reason = e.to_string();
+                        rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
+                        failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
+                    }
+                    Err(e) => return Err(e),
+                }
+                bar.inc(1);
+            }
         }
         if failures.len() > failed {
             bar.set_prefix(format!(
@@ -252,11 +280,14 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
     }
     bar.finish_and_clear();
     bars.remove(&bar);
+    // In unit order (a batch's ordering failures were recorded before its measured rows).
+    rows.sort_by_key(|(u, _)| *u);
+    orders_rows.sort_by_key(|(u, _)| *u);
 
     let written = match (&header, opts.shard) {
         (Some(header), Some(shard)) => {
             if draws {
-                shard::write(&shard::path(&orders_csv, shard), header, ORDER_COLUMNS, &orders)?;
+                shard::write(&shard::path(&orders_csv, shard), header, ORDER_COLUMNS, &orders_rows)?;
             }
             let path = shard::path(&csv, shard);
             shard::write(&path, header, COLUMNS, &rows)?;
@@ -264,7 +295,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         }
         _ => {
             if draws {
-                write_csv(&orders_csv, orders.iter().map(|(_, o)| o))?;
+                write_csv(&orders_csv, orders_rows.iter().map(|(_, o)| o))?;
             }
             write_csv(&csv, rows.iter().map(|(_, r)| r))?;
             csv

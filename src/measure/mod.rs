@@ -114,6 +114,14 @@ pub trait Metric: Sync {
     /// Measures `draws` (called only when [`Metric::reported`] is not empty).
     fn measure(&self, draws: &Draws) -> Result<Vec<Value>>;
 
+    /// Measures several orders of one scene, drawn over the same frames with the same options
+    /// and backend (one [`Draws`] per order): one list of values per order, each what
+    /// [`Metric::measure`] gives for it. A metric whose work does not depend on the order (the
+    /// rasterization behind overdraw) overrides it to do that work once.
+    fn measure_many(&self, many: &[Draws]) -> Result<Vec<Vec<Value>>> {
+        many.iter().map(|draws| self.measure(draws)).collect()
+    }
+
     /// How `eval`'s table and `order`'s summary show its summary values (those of all frames and
     /// no single view): `(column title, cell)` pairs. By default one column per value.
     fn columns(&self, values: &[&Value]) -> Vec<(String, String)> {
@@ -291,6 +299,11 @@ impl<'a> Draws<'a> {
         self.uses.iter().enumerate().filter(|(_, n)| **n > 0).map(|(b, &n)| (b, n))
     }
 
+    /// The buffer drawn at frame `f` from camera `v`.
+    pub fn pick(&self, f: usize, v: usize) -> usize {
+        self.picks[(f - self.frames.start) * self.cameras.len() + v]
+    }
+
     /// The views of frame `f` grouped by the buffer that draws them, in buffer order.
     pub fn groups(&self, f: usize) -> Vec<(usize, Vec<usize>)> {
         let views = self.cameras.len();
@@ -374,18 +387,25 @@ pub fn evaluate(
     options: &MeasureOptions,
     raster: &dyn RasterBackend,
 ) -> Result<Evaluation> {
+    let ordered = order_timed(scene, method, options)?;
+    let measured = measure(scene, &ordered.orders, options, raster)?;
+    Ok(Evaluation { measured, ..ordered })
+}
+
+/// Orders `scene` with `method`, timed, as [`evaluate`] does: an evaluation with nothing
+/// measured yet ([`measure_many`] measures several together).
+pub fn order_timed(scene: &Scene, method: &Resolved, options: &MeasureOptions) -> Result<Evaluation> {
     let start = Instant::now();
     let orders =
         if options.per_draw_call { order::draw_calls::run(method, scene)? } else { order::run(method, scene)? };
     let seconds = start.elapsed().as_secs_f64();
-    let measured = measure(scene, &orders, options, raster)?;
     Ok(Evaluation {
         method: method.canonical(),
         method_name: method.method.name,
         peer: method.method.peer,
         seconds,
         orders,
-        measured,
+        measured: Vec::new(),
     })
 }
 
@@ -396,20 +416,41 @@ pub fn measure(
     options: &MeasureOptions,
     raster: &dyn RasterBackend,
 ) -> Result<Vec<Measured>> {
+    Ok(measure_many(scene, &[orders], options, raster)?.pop().expect("one order, one list"))
+}
+
+/// Measures several orders of `scene` (one per method compared) with every metric `options` ask
+/// for: per order, what [`measure`] gives for it, but with the work that does not depend on the
+/// order (rasterizing each view, for overdraw on the CPU) done once for all of them.
+pub fn measure_many(
+    scene: &Scene,
+    orders: &[&Orders],
+    options: &MeasureOptions,
+    raster: &dyn RasterBackend,
+) -> Result<Vec<Vec<Measured>>> {
     // A progressive mesh is measured level by level, every value naming its level.
     let parts: Vec<(Range<usize>, Option<usize>)> = match &scene.frames.kind {
         Kind::Levels(_) => (0..scene.frames.len()).map(|f| (f..f + 1, Some(f))).collect(),
         _ => vec![(0..scene.frames.len(), None)],
     };
-    let draws: Vec<(Draws, Option<usize>)> =
-        parts.into_iter().map(|(frames, level)| (Draws::new(scene, orders, options, raster, frames), level)).collect();
-    let mut measured = Vec::new();
+    let draws: Vec<(Vec<Draws>, Option<usize>)> = parts
+        .into_iter()
+        .map(|(frames, level)| {
+            let many = orders.iter().map(|o| Draws::new(scene, o, options, raster, frames.clone())).collect();
+            (many, level)
+        })
+        .collect();
+    let mut measured: Vec<Vec<Measured>> = vec![Vec::new(); orders.len()];
     for &metric in METRICS.iter().filter(|m| !m.reported(options).is_empty()) {
-        let mut values = Vec::new();
-        for (draws, level) in &draws {
-            values.extend(metric.measure(draws)?.into_iter().map(|v| Value { level: *level, ..v }));
+        let mut values: Vec<Vec<Value>> = vec![Vec::new(); orders.len()];
+        for (many, level) in &draws {
+            for (values, new) in values.iter_mut().zip(metric.measure_many(many)?) {
+                values.extend(new.into_iter().map(|v| Value { level: *level, ..v }));
+            }
         }
-        measured.push(Measured { metric, values });
+        for (measured, values) in measured.iter_mut().zip(values) {
+            measured.push(Measured { metric, values });
+        }
     }
     Ok(measured)
 }

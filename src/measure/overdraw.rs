@@ -71,53 +71,49 @@ impl Metric for Overdraw {
         if options.views.is_some() { NAMES.iter().map(|n| n.name).collect() } else { Vec::new() }
     }
 
-    /// Per frame, the views are grouped by the buffer that draws them and each group is counted
-    /// in one call of the backend. Summaries come for all frames (`ovr_empty` first; the
-    /// statistics only when some view sees a front face), then for each clip of an animation
-    /// with several, each with the per-view ratios (`ovr`) of the views that see something.
     fn measure(&self, draws: &Draws) -> Result<Vec<Value>> {
+        Ok(self.measure_many(std::slice::from_ref(draws))?.pop().expect("one draws, one list"))
+    }
+
+    /// Per frame, every view's draws (one per order measured) are counted in one call of the
+    /// backend, which the CPU backend answers from one rasterization per view
+    /// ([`crate::raster::RasterBackend::count_orders`]). Summaries come for all frames
+    /// (`ovr_empty` first; the statistics only when some view sees a front face), then for each
+    /// clip of an animation with several, each with the per-view ratios (`ovr`) of the views
+    /// that see something.
+    fn measure_many(&self, many: &[Draws]) -> Result<Vec<Vec<Value>>> {
+        let Some(draws) = many.first() else { return Ok(Vec::new()) };
         let views = draws.cameras.len();
         let first = draws.frames.start;
-        let mut per_view = vec![ViewCounts::default(); draws.frames.len() * views];
+        let mut per_view = vec![vec![ViewCounts::default(); draws.frames.len() * views]; many.len()];
         for f in draws.frames.clone() {
-            for (b, group) in draws.groups(f) {
-                let cameras: Vec<_> = group.iter().map(|&v| draws.cameras[v]).collect();
-                let counts = draws
-                    .raster
-                    .count(draws.positions(f), &draws.triangles(b), &cameras, draws.options.res)
-                    .map_err(|e| naming_mesh(&draws.scene.mesh.name, e))?;
-                for (&v, c) in group.iter().zip(counts) {
-                    per_view[(f - first) * views + v] = c;
+            // The distinct buffers drawn at this frame, and per view the one each order's lookup picks.
+            let mut orders: Vec<(usize, usize)> = Vec::new();
+            let picks: Vec<Vec<usize>> = (0..views)
+                .map(|v| {
+                    let index = |d: usize| {
+                        let key = (d, many[d].pick(f, v));
+                        orders.iter().position(|&o| o == key).unwrap_or_else(|| {
+                            orders.push(key);
+                            orders.len() - 1
+                        })
+                    };
+                    (0..many.len()).map(index).collect()
+                })
+                .collect();
+            let slices: Vec<&[u32]> = orders.iter().map(|&(d, b)| &many[d].orders.buffers[b].order[..]).collect();
+            let triangles = draws.scene.frames.triangles(f, &draws.scene.mesh);
+            let counts = draws
+                .raster
+                .count_orders(draws.positions(f), &triangles, &slices, &draws.cameras, &picks, draws.options.res)
+                .map_err(|e| naming_mesh(&draws.scene.mesh.name, e))?;
+            for (v, counts) in counts.into_iter().enumerate() {
+                for (d, c) in counts.into_iter().enumerate() {
+                    per_view[d][(f - first) * views + v] = c;
                 }
             }
         }
-        let all = std::iter::once((None, draws.frames.clone()));
-        let clips = draws.clips().iter().map(|(name, frames)| (Some(name.clone()), frames.clone()));
-        let mut values = Vec::new();
-        for (clip, frames) in all.chain(clips) {
-            let counts = &per_view[(frames.start - first) * views..(frames.end - first) * views];
-            let at = |metric: &'static str, value: f64| Value {
-                views: draws.views(),
-                clip: clip.clone(),
-                ..Value::new(metric, value)
-            };
-            values.push(at("ovr_empty", counts.iter().filter(|v| v.ovr().is_none()).count() as f64));
-            if let Some(s) = OverdrawSummary::of(counts) {
-                for (metric, value) in [
-                    ("ovr_mean", s.mean),
-                    ("ovr_max", s.max),
-                    ("ovr_min", s.min),
-                    ("ovr_var", s.variance),
-                    ("ovr_sum", s.ratio_of_sums),
-                ] {
-                    values.push(at(metric, value));
-                }
-            }
-            for (i, ratio) in counts.iter().enumerate().filter_map(|(i, c)| Some((i, c.ovr()?))) {
-                values.push(Value { view: Some(i), ..at("ovr", ratio) });
-            }
-        }
-        Ok(values)
+        Ok(per_view.iter().map(|counts| summaries(draws, counts)).collect())
     }
 
     fn columns(&self, values: &[&Value]) -> Vec<(String, String)> {
@@ -129,4 +125,34 @@ impl Metric for Overdraw {
         };
         vec![(format!("OVR mean/max/var {views}@{res}"), cell)]
     }
+}
+
+/// The values of one order's per-view counts (frame-major over `draws`' frames): for all frames,
+/// then per clip.
+fn summaries(draws: &Draws, per_view: &[ViewCounts]) -> Vec<Value> {
+    let views = draws.cameras.len();
+    let first = draws.frames.start;
+    let all = std::iter::once((None, draws.frames.clone()));
+    let clips = draws.clips().iter().map(|(name, frames)| (Some(name.clone()), frames.clone()));
+    let mut values = Vec::new();
+    for (clip, frames) in all.chain(clips) {
+        let counts = &per_view[(frames.start - first) * views..(frames.end - first) * views];
+        let at = |metric: &'static str, value: f64| Value { views: draws.views(), clip: clip.clone(), ..Value::new(metric, value) };
+        values.push(at("ovr_empty", counts.iter().filter(|v| v.ovr().is_none()).count() as f64));
+        if let Some(s) = OverdrawSummary::of(counts) {
+            for (metric, value) in [
+                ("ovr_mean", s.mean),
+                ("ovr_max", s.max),
+                ("ovr_min", s.min),
+                ("ovr_var", s.variance),
+                ("ovr_sum", s.ratio_of_sums),
+            ] {
+                values.push(at(metric, value));
+            }
+        }
+        for (i, ratio) in counts.iter().enumerate().filter_map(|(i, c)| Some((i, c.ovr()?))) {
+            values.push(Value { view: Some(i), ..at("ovr", ratio) });
+        }
+    }
+    values
 }

@@ -55,7 +55,8 @@ use super::tipsify::FIFO_CACHE;
 use super::{Clustered, Lookup, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::{Frames, Scene};
-use crate::raster::cpu::{Fragment, fragments};
+use crate::raster::cpu::depth_layers;
+use crate::raster::layers::{DepthLayers, ranks};
 use crate::raster::naming_mesh;
 use crate::raster::views::{Camera, icosphere_directions, perspective};
 
@@ -243,6 +244,11 @@ impl Hs17 {
         let nodes = rasterize_nodes(scene, frames.clone(), self.res)?;
         clock.lap("rasterization");
         let mut assignment: Vec<u16> = vec![u16::MAX; nodes.len()];
+        // Step 2's integrated distance d(p) of every patch for every cluster (patch-major:
+        // `integrated[p × k + c]`), summed over the nodes `counted` in that cluster.
+        let k = buffers.len();
+        let mut integrated = vec![0.0f64; scene.patch_count() * k];
+        let mut counted: Vec<u16> = vec![u16::MAX; nodes.len()];
         let mut iteration = 0;
         // The round with the fewest passing fragments so far: its fragments, buffers and
         // assignment (a buffer set and the assignment made from it, so the lookup stays true to
@@ -251,7 +257,7 @@ impl Hs17 {
         let mut stalled = 0;
         loop {
             iteration += 1;
-            let (next, passed) = assign(&nodes, &buffers, &assignment, scene.triangles.len());
+            let (next, passed) = assign(&nodes, &buffers, &assignment);
             clock.lap("assignment");
             let settled = next == assignment;
             assignment = next;
@@ -266,19 +272,37 @@ impl Hs17 {
                 let (_, buffers, assignment) = best.expect("one round has run");
                 return Ok(KMeans { buffers, assignment, iterations: iteration, converged });
             }
-            for (c, buffer) in buffers.iter_mut().enumerate() {
-                let members: Vec<usize> = (0..nodes.len()).filter(|&n| usize::from(assignment[n]) == c).collect();
-                if members.is_empty() {
-                    continue;
+            // Step 2 for the clusters whose nodes changed: the integrated distances follow the
+            // nodes that moved (a few percent of them after the first rounds), so a round costs
+            // patches × moved nodes rather than patches × nodes. In f64, where sums of these f32
+            // distances (between 1 and 8 or so, from viewpoints at three radii) are exact, so
+            // adding and taking away a node leaves the sum a recount would give.
+            let moved: Vec<usize> = (0..nodes.len()).filter(|&n| counted[n] != assignment[n]).collect();
+            integrated.par_chunks_mut(k).enumerate().for_each(|(p, sums)| {
+                let at = &centroids[p * frame_count..(p + 1) * frame_count];
+                for &n in &moved {
+                    let d = f64::from(scene.cameras[n % views].unit_eye().distance(at[n / views]));
+                    if let Some(before) = sums.get_mut(usize::from(counted[n])) {
+                        *before -= d;
+                    }
+                    sums[usize::from(assignment[n])] += d;
                 }
-                let d: Vec<f32> = (0..scene.patch_count())
-                    .into_par_iter()
-                    .map(|p| {
-                        let at = &centroids[p * frame_count..(p + 1) * frame_count];
-                        members.iter().map(|&n| scene.cameras[n % views].unit_eye().distance(at[n / views])).sum()
-                    })
-                    .collect();
-                *buffer = scene.buffer(&sort_by_key(&d, |&d| d));
+            });
+            let mut changed = vec![false; k];
+            for &n in &moved {
+                for c in [counted[n], assignment[n]] {
+                    if let Some(flag) = changed.get_mut(usize::from(c)) {
+                        *flag = true;
+                    }
+                }
+                counted[n] = assignment[n];
+            }
+            for (c, buffer) in buffers.iter_mut().enumerate() {
+                // A cluster left with no node keeps its buffer.
+                if changed[c] && assignment.contains(&(c as u16)) {
+                    let column: Vec<f64> = integrated.iter().skip(c).step_by(k).copied().collect();
+                    *buffer = scene.buffer(&sort_by_key(&column, |&d| d));
+                }
             }
             clock.lap("buffers");
         }
@@ -309,8 +333,8 @@ impl Hs17 {
 }
 
 /// Indices `0..keys.len()` sorted by increasing `key`, ties by index.
-fn sort_by_key<T>(keys: &[T], key: impl Fn(&T) -> f32) -> Vec<usize> {
-    let values: Vec<f32> = keys.iter().map(key).collect();
+fn sort_by_key<T, K: Into<f64>>(keys: &[T], key: impl Fn(&T) -> K) -> Vec<usize> {
+    let values: Vec<f64> = keys.iter().map(|k| key(k).into()).collect();
     let mut sorted: Vec<usize> = (0..keys.len()).collect();
     sorted.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
     sorted
@@ -341,123 +365,35 @@ fn patch_centroids(scene: &Nodes, frames: Range<usize>) -> Vec<Vec3> {
 }
 
 /// Every node of `frames` rasterized once: node `(f − first) × views + v` is frame f seen by
-/// camera v. The depth test of any buffer is then replayed from these ([`Contested::passed`]).
-fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<Vec<Contested>> {
-    let views = scene.cameras.len();
-    (0..frames.len() * views)
-        .into_par_iter()
-        .map_init(
-            || (Vec::new(), Vec::new()),
-            |(fragments_, slots), n| {
-                let (frame, camera) = (frames.start + n / views, &scene.cameras[n % views]);
-                fragments(&scene.keyframes.frames[frame], scene.triangles, camera, res, fragments_)
-                    .map_err(|e| naming_mesh(scene.name, e))?;
-                Ok(Contested::of(fragments_, res, slots))
-            },
-        )
-        .collect()
+/// camera v. The depth test of any buffer is then replayed from these
+/// ([`DepthLayers::contested_passes`]).
+fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<Vec<DepthLayers>> {
+    let mut nodes = Vec::with_capacity(frames.len() * scene.cameras.len());
+    for f in frames {
+        nodes.extend(
+            depth_layers(&scene.keyframes.frames[f], scene.triangles, scene.cameras, res)
+                .map_err(|e| naming_mesh(scene.name, e))?,
+        );
+    }
+    Ok(nodes)
 }
 
 /// Step 1: each node to the buffer with the fewest passing fragments; a node keeps its
 /// `previous` buffer when that one ties for the fewest. Also returns those fewest fragments
 /// summed over the nodes: what the assignment minimizes.
-fn assign(nodes: &[Contested], buffers: &[Clustered], previous: &[u16], triangles: usize) -> (Vec<u16>, u64) {
-    let ranks: Vec<Vec<u32>> = buffers
-        .par_iter()
-        .map(|b| {
-            let mut rank = vec![0; triangles];
-            for (i, &t) in b.order.iter().enumerate() {
-                rank[t as usize] = i as u32;
-            }
-            rank
-        })
-        .collect();
+fn assign(nodes: &[DepthLayers], buffers: &[Clustered], previous: &[u16]) -> (Vec<u16>, u64) {
+    let ranks: Vec<Vec<u32>> = buffers.par_iter().map(|b| ranks(&b.order)).collect();
     let chosen: Vec<(u16, u32)> = nodes
         .par_iter()
         .zip(previous)
         .map(|(node, &before)| {
-            let passed: Vec<u32> = ranks.iter().map(|rank| node.passed(rank)).collect();
+            let passed: Vec<u32> = ranks.iter().map(|rank| node.contested_passes(rank)).collect();
             let best = *passed.iter().min().expect("at least one buffer");
             let keep = passed.get(usize::from(before)).is_some_and(|&p| p == best);
             (if keep { before } else { passed.iter().position(|&p| p == best).unwrap() as u16 }, best)
         })
         .collect();
     (chosen.iter().map(|c| c.0).collect(), chosen.iter().map(|c| u64::from(c.1)).sum())
-}
-
-/// What of one node's rasterization depends on the draw order: the pixels reached by two or
-/// more fragments, each with its triangles nearest first. A pixel with one fragment passes it
-/// in every order, so it cannot favour one buffer and is left out.
-struct Contested {
-    /// Per contested pixel, its triangles by increasing depth; [`TIED`] marks a triangle at the
-    /// same depth as the one before it.
-    triangles: Vec<u32>,
-    /// Pixel `i`'s entries are `triangles[starts[i]..starts[i + 1]]`.
-    starts: Vec<u32>,
-}
-
-/// Flags a triangle id in [`Contested::triangles`] (ids stay below 2³¹: meshes are far smaller).
-const TIED: u32 = 1 << 31;
-
-impl Contested {
-    /// Groups `fragments` by pixel (a counting sort over the image, scratch in `slots`) and keeps
-    /// the contested pixels, each sorted by depth.
-    fn of(fragments: &[Fragment], res: u32, slots: &mut Vec<u32>) -> Contested {
-        let pixels = res as usize * res as usize;
-        slots.clear();
-        slots.resize(pixels + 1, 0);
-        for f in fragments {
-            slots[f.pixel as usize + 1] += 1;
-        }
-        for p in 0..pixels {
-            slots[p + 1] += slots[p];
-        }
-        let mut by_pixel = vec![(0.0f32, 0u32); fragments.len()];
-        let mut next = slots[..pixels].to_vec();
-        for f in fragments {
-            let slot = &mut next[f.pixel as usize];
-            by_pixel[*slot as usize] = (f.depth, f.triangle);
-            *slot += 1;
-        }
-        let (mut triangles, mut starts) = (Vec::new(), vec![0]);
-        for p in 0..pixels {
-            let entries = &mut by_pixel[slots[p] as usize..slots[p + 1] as usize];
-            if entries.len() < 2 {
-                continue;
-            }
-            entries.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for (i, &(depth, t)) in entries.iter().enumerate() {
-                let tied = i > 0 && entries[i - 1].0 == depth;
-                triangles.push(if tied { t | TIED } else { t });
-            }
-            starts.push(triangles.len() as u32);
-        }
-        Contested { triangles, starts }
-    }
-
-    /// Fragments passing a LESS depth test, over the contested pixels, when triangle t is drawn
-    /// `rank[t]`-th. A fragment passes when it is drawn before every nearer one; of fragments at
-    /// one depth only the first drawn can pass.
-    fn passed(&self, rank: &[u32]) -> u32 {
-        let mut passed = 0;
-        for w in self.starts.windows(2) {
-            let entries = &self.triangles[w[0] as usize..w[1] as usize];
-            // The earliest draw among strictly nearer fragments, and among those at this depth.
-            let (mut nearer, mut group) = (u32::MAX, u32::MAX);
-            for &entry in entries {
-                let r = rank[(entry & !TIED) as usize];
-                if entry & TIED == 0 {
-                    passed += u32::from(group < nearer);
-                    nearer = nearer.min(group);
-                    group = r;
-                } else {
-                    group = group.min(r);
-                }
-            }
-            passed += u32::from(group < nearer);
-        }
-        passed
-    }
 }
 
 /// Wall time per phase, summed over laps.

@@ -24,6 +24,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::layers::{self, DepthLayers};
 use super::views::Camera;
 use super::{RasterBackend, ViewCounts};
 use crate::error::{Error, Result};
@@ -59,31 +60,93 @@ impl RasterBackend for CpuRaster {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>> {
-        check_resolution(res)?;
-        // The positions go into the unit frame once per run of cameras with one framing (all of
-        // them, from a view set), the same f32 values the GPU backend uploads. A failure names
-        // the first view that fails, whichever thread met one first.
-        let mut counts = Vec::with_capacity(cameras.len());
-        for run in cameras.chunk_by(|a, b| a.framing == b.framing) {
-            let (first, unit) = (counts.len(), run[0].framing.unit_positions(positions));
-            let run: Vec<ViewCounts> = run
-                .par_iter()
-                .enumerate()
-                .map_init(
-                    || (Vec::new(), Vec::new()),
-                    |(screen, depth), (i, camera)| {
-                        project(&unit, camera, res, screen)
-                            .map_err(|why| Error::usage(format!("view {}: {why}", first + i)))?;
-                        Ok(draw(screen, triangles, res, depth, |_| {}))
-                    },
-                )
-                .collect::<Vec<Result<ViewCounts>>>()
-                .into_iter()
-                .collect::<Result<_>>()?;
-            counts.extend(run);
-        }
-        Ok(counts)
+        each_view(positions, cameras, res, Vec::new, |depth, screen, _| draw(screen, triangles, res, depth, |_| {}))
     }
+
+    /// Each view rasterized once, its fragments kept as [`DepthLayers`], and every order picked
+    /// for it counted by replaying the depth test: the same counts as drawing each order.
+    fn count_orders(
+        &self,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        orders: &[&[u32]],
+        cameras: &[Camera],
+        picks: &[Vec<usize>],
+        res: u32,
+    ) -> Result<Vec<Vec<ViewCounts>>> {
+        // A replay is only the same count for a permutation of every triangle.
+        if orders.iter().any(|o| o.len() != triangles.len()) {
+            return super::count_each_order(self, positions, triangles, orders, cameras, picks, res);
+        }
+        let ranks: Vec<Vec<u32>> = orders.par_iter().map(|o| layers::ranks(o)).collect();
+        each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, v| {
+            let layers = scratch.layers(screen, triangles, res);
+            picks[v].iter().map(|&o| layers.counts(&ranks[o])).collect()
+        })
+    }
+}
+
+/// Every camera's view of `triangles` as [`DepthLayers`], from which the depth test of any
+/// order of them is replayed, under exactly the rules [`CpuRaster`] counts by.
+pub fn depth_layers(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    cameras: &[Camera],
+    res: u32,
+) -> Result<Vec<DepthLayers>> {
+    each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, _| {
+        scratch.layers(screen, triangles, res)
+    })
+}
+
+/// One thread's buffers for [`DepthLayers`]: the depth buffer, the fragments, the pixel slots.
+#[derive(Default)]
+struct LayerScratch {
+    depth: Vec<f32>,
+    fragments: Vec<Fragment>,
+    slots: Vec<u32>,
+}
+
+impl LayerScratch {
+    fn layers(&mut self, screen: &[ScreenVertex], triangles: &[[u32; 3]], res: u32) -> DepthLayers {
+        self.fragments.clear();
+        draw(screen, triangles, res, &mut self.depth, |f| self.fragments.push(f));
+        DepthLayers::of(&self.fragments, res, &mut self.slots)
+    }
+}
+
+/// `view(scratch, projected vertices, camera index)` for every camera, views in parallel (each
+/// thread with its own `scratch`). The positions go into the unit frame once per run of cameras
+/// with one framing (all of them, from a view set), the same f32 values the GPU backend
+/// uploads. A failure names the first view that fails, whichever thread met one first.
+fn each_view<T: Send, S: Send>(
+    positions: &[Vec3],
+    cameras: &[Camera],
+    res: u32,
+    scratch: impl Fn() -> S + Sync + Send,
+    view: impl Fn(&mut S, &[ScreenVertex], usize) -> T + Sync + Send,
+) -> Result<Vec<T>> {
+    check_resolution(res)?;
+    let mut out = Vec::with_capacity(cameras.len());
+    for run in cameras.chunk_by(|a, b| a.framing == b.framing) {
+        let (first, unit) = (out.len(), run[0].framing.unit_positions(positions));
+        let run: Vec<T> = run
+            .par_iter()
+            .enumerate()
+            .map_init(
+                || (Vec::new(), scratch()),
+                |(screen, scratch), (i, camera)| {
+                    project(&unit, camera, res, screen)
+                        .map_err(|why| Error::usage(format!("view {}: {why}", first + i)))?;
+                    Ok(view(scratch, screen, first + i))
+                },
+            )
+            .collect::<Vec<Result<T>>>()
+            .into_iter()
+            .collect::<Result<_>>()?;
+        out.extend(run);
+    }
+    Ok(out)
 }
 
 /// The triangle seen at each pixel (row-major, row 0 at the bottom), `u32::MAX` where none: the

@@ -2,6 +2,7 @@
 //! backend), returning the same per-view counts under the same rules so they can be cross-checked.
 
 pub mod cpu;
+pub mod layers;
 pub mod views;
 
 use glam::Vec3;
@@ -51,4 +52,51 @@ pub trait RasterBackend: Sync {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>>;
+
+    /// Counts several draw orders of the same `triangles` from each camera: `orders` are
+    /// permutations of the triangles' indices, and `picks[v]` lists the orders (indices into
+    /// `orders`) drawn from camera `v`. Returns, per camera, one count per pick: what
+    /// [`RasterBackend::count`] gives for that order. Several methods measured over one view set
+    /// draw the same triangles from the same cameras, each in its own order; this draws each
+    /// order with the views that pick it, and the CPU backend rasterizes each view once instead.
+    fn count_orders(
+        &self,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        orders: &[&[u32]],
+        cameras: &[Camera],
+        picks: &[Vec<usize>],
+        res: u32,
+    ) -> Result<Vec<Vec<ViewCounts>>> {
+        count_each_order(self, positions, triangles, orders, cameras, picks, res)
+    }
+}
+
+/// [`RasterBackend::count_orders`] by drawing each order with the views that pick it.
+pub fn count_each_order<B: RasterBackend + ?Sized>(
+    backend: &B,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    orders: &[&[u32]],
+    cameras: &[Camera],
+    picks: &[Vec<usize>],
+    res: u32,
+) -> Result<Vec<Vec<ViewCounts>>> {
+    let mut counts: Vec<Vec<ViewCounts>> = picks.iter().map(|p| vec![ViewCounts::default(); p.len()]).collect();
+    for (o, order) in orders.iter().enumerate() {
+        let slots: Vec<(usize, usize)> = picks
+            .iter()
+            .enumerate()
+            .flat_map(|(v, p)| p.iter().enumerate().filter(move |&(_, &q)| q == o).map(move |(s, _)| (v, s)))
+            .collect();
+        if slots.is_empty() {
+            continue;
+        }
+        let drawn: Vec<[u32; 3]> = order.iter().map(|&t| triangles[t as usize]).collect();
+        let views: Vec<Camera> = slots.iter().map(|&(v, _)| cameras[v]).collect();
+        for (&(v, s), c) in slots.iter().zip(backend.count(positions, &drawn, &views, res)?) {
+            counts[v][s] = c;
+        }
+    }
+    Ok(counts)
 }

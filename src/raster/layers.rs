@@ -1,0 +1,114 @@
+//! One view's fragments grouped by pixel and sorted by depth, so that the depth test of *any*
+//! draw order of the same triangles is replayed without rasterizing again.
+//!
+//! Under a LESS test into a buffer cleared to 1.0, a fragment passes when its depth is below 1.0
+//! and below that of every fragment drawn before it at its pixel. With a pixel's fragments
+//! sorted nearest first, a draw order's passes there are counted in one scan: a fragment passes
+//! when it is drawn before every nearer one, and of fragments at one depth only the first drawn
+//! can pass. A pixel with one fragment passes it in every order, so only the pixels reached by
+//! two or more (the contested ones) are kept; the rest are counted once.
+//!
+//! Rasterizing costs a pass over every triangle; a replay costs a pass over the contested
+//! fragments, far fewer on a dense mesh at the images' sizes. `hs17` replays every buffer of
+//! every k-means round on its nodes, and the CPU backend counts every method's order of one
+//! scene from one rasterization per view ([`super::cpu::CpuRaster`]'s `count_orders`).
+
+use super::ViewCounts;
+use super::cpu::Fragment;
+
+/// The order-dependent part of one view: its contested pixels, each with its triangles nearest
+/// first; and the pixels with one fragment, which pass it in any order.
+#[derive(Debug, Default)]
+pub struct DepthLayers {
+    /// Per contested pixel, its triangles by increasing depth; [`TIED`] marks a triangle at the
+    /// same depth as the one before it.
+    triangles: Vec<u32>,
+    /// Contested pixel `i`'s entries are `triangles[starts[i]..starts[i + 1]]`.
+    starts: Vec<u32>,
+    /// Pixels reached by exactly one fragment that can pass (depth below 1.0).
+    singles: u64,
+}
+
+/// Flags a triangle id in [`DepthLayers::triangles`] (ids stay below 2³¹: meshes are far smaller).
+const TIED: u32 = 1 << 31;
+
+impl DepthLayers {
+    /// Groups `fragments` (of an image `res` pixels square) by pixel, a counting sort over the
+    /// image with scratch in `slots`, and keeps the contested pixels, each sorted by depth.
+    /// Fragments at depth 1.0 or beyond (or NaN) can never pass and are left out.
+    pub fn of(fragments: &[Fragment], res: u32, slots: &mut Vec<u32>) -> DepthLayers {
+        let pixels = res as usize * res as usize;
+        let can_pass = |f: &&Fragment| f.depth < 1.0;
+        slots.clear();
+        slots.resize(pixels + 1, 0);
+        for f in fragments.iter().filter(can_pass) {
+            slots[f.pixel as usize + 1] += 1;
+        }
+        for p in 0..pixels {
+            slots[p + 1] += slots[p];
+        }
+        let mut by_pixel = vec![(0.0f32, 0u32); slots[pixels] as usize];
+        let mut next = slots[..pixels].to_vec();
+        for f in fragments.iter().filter(can_pass) {
+            let slot = &mut next[f.pixel as usize];
+            by_pixel[*slot as usize] = (f.depth, f.triangle);
+            *slot += 1;
+        }
+        let mut layers = DepthLayers { starts: vec![0], ..DepthLayers::default() };
+        for p in 0..pixels {
+            let entries = &mut by_pixel[slots[p] as usize..slots[p + 1] as usize];
+            if entries.len() < 2 {
+                layers.singles += entries.len() as u64;
+                continue;
+            }
+            entries.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (i, &(depth, t)) in entries.iter().enumerate() {
+                let tied = i > 0 && entries[i - 1].0 == depth;
+                layers.triangles.push(if tied { t | TIED } else { t });
+            }
+            layers.starts.push(layers.triangles.len() as u32);
+        }
+        layers
+    }
+
+    /// Fragments passing the depth test over the contested pixels when triangle t is drawn
+    /// `rank[t]`-th.
+    pub fn contested_passes(&self, rank: &[u32]) -> u32 {
+        let mut passed = 0;
+        for w in self.starts.windows(2) {
+            let entries = &self.triangles[w[0] as usize..w[1] as usize];
+            // The earliest draw among strictly nearer fragments, and among those at this depth.
+            let (mut nearer, mut group) = (u32::MAX, u32::MAX);
+            for &entry in entries {
+                let r = rank[(entry & !TIED) as usize];
+                if entry & TIED == 0 {
+                    passed += u32::from(group < nearer);
+                    nearer = nearer.min(group);
+                    group = r;
+                } else {
+                    group = group.min(r);
+                }
+            }
+            passed += u32::from(group < nearer);
+        }
+        passed
+    }
+
+    /// The view's counts when triangle t is drawn `rank[t]`-th: what drawing them in that order
+    /// into a cleared depth buffer counts.
+    pub fn counts(&self, rank: &[u32]) -> ViewCounts {
+        ViewCounts {
+            covered: self.singles + (self.starts.len() - 1) as u64,
+            passed: self.singles + u64::from(self.contested_passes(rank)),
+        }
+    }
+}
+
+/// Per triangle, its position in `order` (a permutation of `0..order.len()`).
+pub fn ranks(order: &[u32]) -> Vec<u32> {
+    let mut rank = vec![0; order.len()];
+    for (i, &t) in order.iter().enumerate() {
+        rank[t as usize] = i as u32;
+    }
+    rank
+}
