@@ -126,14 +126,23 @@ pub fn eval(
     }
     let buffers = scene.frames.is_animation() || resolved.iter().any(|r| r.method.per_node);
     let mut table = tables::EvalTable::new(buffers);
-    for method in &resolved {
-        let e = measure::evaluate(&scene, method, &measuring.options, measuring.raster.as_ref())?;
+    // Every method orders, then their orders are measured together (each view rasterized once).
+    let mut evaluations = resolved
+        .iter()
+        .map(|method| measure::order_timed(&scene, method, &measuring.options))
+        .collect::<Result<Vec<_>>>()?;
+    let orders: Vec<&Orders> = evaluations.iter().map(|e| &e.orders).collect();
+    let measured = measure::measure_many(&scene, &orders, &measuring.options, measuring.raster.as_ref())?;
+    for (e, measured) in evaluations.iter_mut().zip(measured) {
+        e.measured = measured;
+    }
+    for e in &evaluations {
         if json {
-            for line in tables::eval_json(&scene, &e, &measuring.raster.describe()) {
+            for line in tables::eval_json(&scene, e, &measuring.raster.describe()) {
                 println!("{line}");
             }
         } else {
-            table.push(&scene, &e);
+            table.push(&scene, e);
         }
     }
     if !json {

@@ -1,7 +1,10 @@
-//! Measuring orders: order a scene with a method and measure what it draws. One [`evaluate`] serves
+//! Measuring orders: order a scene with a method and measure what it draws. One path serves
 //! `eval`, `order` and every experiment, for a static mesh (one frame, one buffer) as for an
 //! animation drawn with buffers picked per keyframe and view, so every number triorder prints is
-//! computed the same way.
+//! computed the same way: [`evaluate`] orders and measures one method; a run orders each of a
+//! model's methods ([`order_timed`]) and measures them together ([`measure_many`]), which gives
+//! each order the values [`measure`] gives it but does the work that does not depend on the
+//! order once (each view rasterized once for overdraw and translucency on the CPU).
 //!
 //! What is measured is a list of [`Metric`]s ([`METRICS`]). Each draws on the same [`Draws`]:
 //! the scene's frames, the view set's cameras, and the buffer the method's lookup picks for each

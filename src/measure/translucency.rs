@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use super::{Draws, MeasureOptions, Metric, Name, Value};
 use crate::error::Result;
 use crate::raster::cpu::{self, Fragment};
+use crate::raster::layers;
 use crate::raster::naming_mesh;
 
 /// The blending weight of every fragment.
@@ -69,11 +70,18 @@ pub fn colour(id: u32) -> [f32; 3] {
     [0, 21, 42].map(|shift| ((x >> shift) & 0x1F_FFFF) as f32 / 0x1F_FFFF as f32)
 }
 
-/// Visits every pixel the `fragments` cover (one view's, in draw order; `ids[t]` the triangle id
-/// of drawn triangle `t`; a `res`² image) with its colour blended in draw order, its exact colour
-/// (blended back to front) and its fragment pairs blended nearer first.
-fn blend_pixels(fragments: &[Fragment], ids: &[u32], res: u32, mut visit: impl FnMut(usize, [f32; 3], [f32; 3], u64)) {
-    // The fragments grouped by pixel, each pixel's in draw order (a counting sort, stable).
+/// Visits every pixel the `fragments` cover (one view's, of a `res`² image) with its colour
+/// blended in draw order, its exact colour (blended back to front) and its fragment pairs
+/// blended nearer first. A fragment's `triangle` is drawn `drawn(triangle)`-th and coloured as
+/// triangle id `id(triangle)`: the fragments may come in any order.
+fn blend_pixels(
+    fragments: &[Fragment],
+    res: u32,
+    drawn: impl Fn(u32) -> u32,
+    id: impl Fn(u32) -> u32,
+    mut visit: impl FnMut(usize, [f32; 3], [f32; 3], u64),
+) {
+    // The fragments grouped by pixel (a counting sort, stable), then each pixel's in draw order.
     let pixels = (res as usize) * (res as usize);
     let mut start = vec![0u32; pixels + 1];
     for f in fragments {
@@ -90,13 +98,13 @@ fn blend_pixels(fragments: &[Fragment], ids: &[u32], res: u32, mut visit: impl F
     }
     let blend = |order: &[u32]| {
         order.iter().fold([0f32; 3], |c, &i| {
-            let own = colour(ids[fragments[i as usize].triangle as usize]);
+            let own = colour(id(fragments[i as usize].triangle));
             [0, 1, 2].map(|k| c[k] * (1.0 - ALPHA) + own[k] * ALPHA)
         })
     };
     let mut far_first: Vec<u32> = Vec::new();
     for p in 0..pixels {
-        let here = &grouped[start[p] as usize..start[p + 1] as usize];
+        let here = &mut grouped[start[p] as usize..start[p + 1] as usize];
         if here.is_empty() {
             continue;
         }
@@ -105,6 +113,8 @@ fn blend_pixels(fragments: &[Fragment], ids: &[u32], res: u32, mut visit: impl F
             visit(p, only, only, 0);
             continue;
         }
+        here.sort_by_key(|&i| drawn(fragments[i as usize].triangle));
+        let here = &*here;
         let depth = |i: u32| fragments[i as usize].depth;
         let pairs = here.iter().enumerate().map(|(a, &i)| here[a + 1..].iter().filter(|&&j| depth(i) < depth(j)).count() as u64).sum();
         far_first.clear();
@@ -117,8 +127,19 @@ fn blend_pixels(fragments: &[Fragment], ids: &[u32], res: u32, mut visit: impl F
 /// The error of drawing `fragments` (one view's, in draw order; `ids[t]` the triangle id of drawn
 /// triangle `t`) blended in draw order, against the exact back-to-front blend, on a `res`² image.
 pub fn view_error(fragments: &[Fragment], ids: &[u32], res: u32) -> ViewError {
+    error_of(fragments, res, |t| t, |t| ids[t as usize])
+}
+
+/// The error of drawing triangle t `rank[t]`-th, from `fragments` of the triangles in any order
+/// whose `triangle` is the triangle's id: [`view_error`] of that order, from fragments that every
+/// order of the same triangles shares.
+pub fn view_error_of_order(fragments: &[Fragment], rank: &[u32], res: u32) -> ViewError {
+    error_of(fragments, res, |t| rank[t as usize], |t| t)
+}
+
+fn error_of(fragments: &[Fragment], res: u32, drawn: impl Fn(u32) -> u32, id: impl Fn(u32) -> u32) -> ViewError {
     let mut error = ViewError::default();
-    blend_pixels(fragments, ids, res, |_, drawn, exact, pairs| {
+    blend_pixels(fragments, res, drawn, id, |_, drawn, exact, pairs| {
         let differences = [0, 1, 2].map(|k| drawn[k] - exact[k]);
         error.covered += 1;
         error.pairs += pairs;
@@ -133,7 +154,7 @@ pub fn view_error(fragments: &[Fragment], ids: &[u32], res: u32) -> ViewError {
 /// the largest channel difference in 1/255 steps (saturating). What a figure of the errors draws.
 pub fn error_picture(fragments: &[Fragment], ids: &[u32], res: u32) -> Vec<u32> {
     let mut picture = vec![0u32; (res as usize) * (res as usize)];
-    blend_pixels(fragments, ids, res, |p, drawn, exact, _| {
+    blend_pixels(fragments, res, |t| t, |t| ids[t as usize], |p, drawn, exact, _| {
         let worst = (0..3).map(|k| (drawn[k] - exact[k]).abs()).fold(0.0f32, f32::max);
         picture[p] = if worst > VISIBLE { 1 + ((worst * 255.0).round() as u32).clamp(1, 254) } else { 1 };
     });
@@ -165,47 +186,30 @@ impl Metric for Translucency {
         if options.translucency && options.views.is_some() { NAMES.iter().map(|n| n.name).collect() } else { Vec::new() }
     }
 
-    /// Every frame from every view, each view with the buffer that draws it; the views in
-    /// parallel, each rasterized once into its fragments.
     fn measure(&self, draws: &Draws) -> Result<Vec<Value>> {
-        let res = draws.options.res;
-        let mut jobs = Vec::new();
-        for f in draws.frames.clone() {
-            for (b, group) in draws.groups(f) {
-                jobs.extend(group.into_iter().map(|v| (f, b, v)));
-            }
-        }
-        let triangles: Vec<Vec<[u32; 3]>> = (0..draws.orders.buffers.len()).map(|b| draws.triangles(b)).collect();
-        let errors = jobs
+        Ok(self.measure_many(std::slice::from_ref(draws))?.pop().expect("one draws, one list"))
+    }
+
+    /// Every frame from every view, the views in parallel, each rasterized once into its
+    /// fragments, which every order measured shares: each order's error is blended from them in
+    /// that order (the buffer its lookup picks for the frame and view).
+    fn measure_many(&self, many: &[Draws]) -> Result<Vec<Vec<Value>>> {
+        let Some(draws) = many.first() else { return Ok(Vec::new()) };
+        let (res, views) = (draws.options.res, draws.cameras.len());
+        // Every buffer's ranks, per order measured.
+        let ranks: Vec<Vec<Vec<u32>>> =
+            many.iter().map(|d| d.orders.buffers.iter().map(|b| layers::ranks(&b.order)).collect()).collect();
+        let jobs: Vec<(usize, usize)> = draws.frames.clone().flat_map(|f| (0..views).map(move |v| (f, v))).collect();
+        let errors: Vec<Vec<ViewError>> = jobs
             .par_iter()
-            .map(|&(f, b, v)| {
-                let mut fragments = Vec::new();
-                cpu::fragments(draws.positions(f), &triangles[b], &draws.cameras[v], res, &mut fragments)
+            .map_init(Vec::new, |fragments, &(f, v)| {
+                let triangles = draws.scene.frames.triangles(f, &draws.scene.mesh);
+                cpu::fragments(draws.positions(f), &triangles, &draws.cameras[v], res, fragments)
                     .map_err(|e| naming_mesh(&draws.scene.mesh.name, e))?;
-                Ok(view_error(&fragments, &draws.orders.buffers[b].order, res))
+                Ok(many.iter().zip(&ranks).map(|(d, r)| view_error_of_order(fragments, &r[d.pick(f, v)], res)).collect())
             })
-            .collect::<Result<Vec<ViewError>>>()?;
-        let at = |metric: &'static str, value: f64| Value { views: draws.views(), ..Value::new(metric, value) };
-        let mut values = Vec::new();
-        type Of = fn(&ViewError) -> Option<f64>;
-        let kinds: [(&'static str, &'static str, Of); 3] = [
-            ("translucency_wrong_pixels", "translucency_wrong_pixels_view", ViewError::wrong_share),
-            ("translucency_rmse", "translucency_rmse_view", ViewError::rmse),
-            ("translucency_pairs", "translucency_pairs_view", ViewError::pairs_per_pixel),
-        ];
-        for (summary, per_view, of) in kinds {
-            let seen: Vec<f64> = errors.iter().filter_map(of).collect();
-            if !seen.is_empty() {
-                values.push(at(summary, seen.iter().sum::<f64>() / seen.len() as f64));
-            }
-            let views = draws.cameras.len();
-            for (&(f, _, v), e) in jobs.iter().zip(&errors) {
-                if let Some(value) = of(e) {
-                    values.push(Value { view: Some((f - draws.frames.start) * views + v), ..at(per_view, value) });
-                }
-            }
-        }
-        Ok(values)
+            .collect::<Result<_>>()?;
+        Ok((0..many.len()).map(|d| values(draws, &jobs, errors.iter().map(|e| e[d]))).collect())
     }
 
     fn columns(&self, values: &[&Value]) -> Vec<(String, String)> {
@@ -216,6 +220,31 @@ impl Metric for Translucency {
         };
         vec![("translucency wrong/RMSE/pairs".to_string(), cell)]
     }
+}
+
+/// One order's values: the means over the views that see something, then each view's.
+fn values(draws: &Draws, jobs: &[(usize, usize)], errors: impl Iterator<Item = ViewError> + Clone) -> Vec<Value> {
+    let at = |metric: &'static str, value: f64| Value { views: draws.views(), ..Value::new(metric, value) };
+    let mut values = Vec::new();
+    type Of = fn(&ViewError) -> Option<f64>;
+    let kinds: [(&'static str, &'static str, Of); 3] = [
+        ("translucency_wrong_pixels", "translucency_wrong_pixels_view", ViewError::wrong_share),
+        ("translucency_rmse", "translucency_rmse_view", ViewError::rmse),
+        ("translucency_pairs", "translucency_pairs_view", ViewError::pairs_per_pixel),
+    ];
+    let views = draws.cameras.len();
+    for (summary, per_view, of) in kinds {
+        let seen: Vec<f64> = errors.clone().filter_map(|e| of(&e)).collect();
+        if !seen.is_empty() {
+            values.push(at(summary, seen.iter().sum::<f64>() / seen.len() as f64));
+        }
+        for (&(f, v), e) in jobs.iter().zip(errors.clone()) {
+            if let Some(value) = of(&e) {
+                values.push(Value { view: Some((f - draws.frames.start) * views + v), ..at(per_view, value) });
+            }
+        }
+    }
+    values
 }
 
 #[cfg(test)]

@@ -34,29 +34,40 @@ const TIED: u32 = 1 << 31;
 
 impl DepthLayers {
     /// Groups `fragments` (of an image `res` pixels square) by pixel, a counting sort over the
-    /// image with scratch in `slots`, and keeps the contested pixels, each sorted by depth.
-    /// Fragments at depth 1.0 or beyond (or NaN) can never pass and are left out.
+    /// run of pixels they reach with scratch in `slots`, and keeps the contested pixels, each
+    /// sorted by depth. Fragments at depth 1.0 or beyond (or NaN) can never pass and are left
+    /// out.
     pub fn of(fragments: &[Fragment], res: u32, slots: &mut Vec<u32>) -> DepthLayers {
-        let pixels = res as usize * res as usize;
+        debug_assert!(fragments.iter().all(|f| (f.pixel as usize) < res as usize * res as usize));
         let can_pass = |f: &&Fragment| f.depth < 1.0;
-        slots.clear();
-        slots.resize(pixels + 1, 0);
-        for f in fragments.iter().filter(can_pass) {
-            slots[f.pixel as usize + 1] += 1;
+        let mut layers = DepthLayers { starts: vec![0], ..DepthLayers::default() };
+        // Only the run of pixels between the first and the last reached: a mesh seen whole
+        // fills part of the image, and the passes below are over that run, not every pixel.
+        let (first, last) =
+            fragments.iter().filter(can_pass).fold((u32::MAX, 0), |(lo, hi), f| (lo.min(f.pixel), hi.max(f.pixel)));
+        if first > last {
+            return layers;
         }
-        for p in 0..pixels {
+        let (first, span) = (first as usize, (last - first) as usize + 1);
+        slots.clear();
+        slots.resize(span + 1, 0);
+        for f in fragments.iter().filter(can_pass) {
+            slots[f.pixel as usize - first + 1] += 1;
+        }
+        for p in 0..span {
             slots[p + 1] += slots[p];
         }
-        let mut by_pixel = vec![(0.0f32, 0u32); slots[pixels] as usize];
-        let mut next = slots[..pixels].to_vec();
+        // Scattered with each pixel's start as its cursor, which leaves it at the pixel's end.
+        let mut by_pixel = vec![(0.0f32, 0u32); slots[span] as usize];
         for f in fragments.iter().filter(can_pass) {
-            let slot = &mut next[f.pixel as usize];
+            let slot = &mut slots[f.pixel as usize - first];
             by_pixel[*slot as usize] = (f.depth, f.triangle);
             *slot += 1;
         }
-        let mut layers = DepthLayers { starts: vec![0], ..DepthLayers::default() };
-        for p in 0..pixels {
-            let entries = &mut by_pixel[slots[p] as usize..slots[p + 1] as usize];
+        let mut start = 0;
+        for &end in &slots[..span] {
+            let entries = &mut by_pixel[start as usize..end as usize];
+            start = end;
             if entries.len() < 2 {
                 layers.singles += entries.len() as u64;
                 continue;
