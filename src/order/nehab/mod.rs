@@ -34,8 +34,9 @@ use crate::error::Result;
 use crate::mesh::Framing;
 use crate::mesh::{Mesh, Scene};
 use crate::measure::OverdrawSummary;
-use crate::raster::cpu::CpuRaster;
-use crate::raster::{RasterBackend, ViewSet, naming_mesh};
+use crate::raster::cpu::depth_layers;
+use crate::raster::layers::ranks;
+use crate::raster::{ViewCounts, ViewSet, naming_mesh};
 
 const CLUSTERS: ParamInfo = ParamInfo {
     name: "clusters",
@@ -126,8 +127,14 @@ impl Ordering for Nehab {
         }
         let mesh = &scene.mesh;
         let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
+        // Every count's order draws the same triangles from the same views: each view is
+        // rasterized once and each order's depth test replayed from it (the counts drawing the
+        // order would give).
+        let layers =
+            depth_layers(&mesh.positions, &mesh.triangles, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?;
         let mean_ovr = |order: &Clustered| -> Result<f64> {
-            let counts = CpuRaster.count(&mesh.positions, &mesh.triangles_in_order(&order.order), &cameras, self.res)?;
+            let rank = ranks(&order.order);
+            let counts: Vec<ViewCounts> = layers.par_iter().map(|view| view.counts(&rank)).collect();
             Ok(OverdrawSummary::of(&counts).map_or(1.0, |s| s.mean))
         };
         // Counts 1, 2, 4, … up to `clusters`, each ordered and measured once.
