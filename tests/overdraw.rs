@@ -11,7 +11,7 @@ use glam::{Mat4, Vec3};
 use triorder::measure::OverdrawSummary;
 use triorder::mesh::Framing;
 use triorder::mesh::{Mesh, VertexAttributes, procedural};
-use triorder::raster::{Camera, ViewCounts, ViewSet};
+use triorder::raster::{Camera, OrderPicks, ViewCounts, ViewSet};
 
 /// Identity camera: world = unit frame = NDC (x, y in -1..1 map to the image, z in 0..1 is depth).
 fn ndc_camera() -> Camera {
@@ -189,7 +189,8 @@ fn counting_many_orders_at_once_is_drawing_each() {
     let cameras = "ico:42".parse::<ViewSet>().unwrap().cameras(Framing::of(&positions), 0);
     let picks: Vec<Vec<usize>> = (0..cameras.len()).map(|v| vec![v % 3, 2, (v + 1) % 3, 2]).collect();
     for backend in common::backends() {
-        let together = backend.count_orders(&positions, &triangles, &slices, &cameras, &picks, 128).unwrap();
+        let draws = OrderPicks { triangles: &triangles, orders: &slices, picks: &picks };
+        let together = backend.count_orders(&positions, &cameras, &draws, 128).unwrap();
         let mut overdrawn = 0;
         for (v, camera) in cameras.iter().enumerate() {
             for (&o, &got) in picks[v].iter().zip(&together[v]) {

@@ -221,29 +221,26 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         // work every order shares (each view rasterized once for overdraw) is done once.
         for batch in todo.chunk_by(|&a, &b| plan.units[a].update == plan.units[b].update) {
             scene.set_update(plan.updates[plan.units[batch[0]].update]);
-            let mut ordered: Vec<(usize, measure::Evaluation)> = Vec::new();
+            let mut ordered: Vec<(usize, Evaluation)> = Vec::new();
             for &u in batch {
                 let method = &plan.methods[plan.units[u].method];
                 bar.set_message(format!("{} · {}", model.name, method.canonical()));
                 match measure::order_timed(&scene, method, &options) {
                     Ok(evaluation) => ordered.push((u, evaluation)),
-                    Err(e) if recorded(&e) => {
-                        let reason = e.to_string();
-                        rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
-                        failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
+                    Err(e) => {
+                        failed_unit(e, model, method, &context, (u, &mut rows), &mut failures)?;
                         bar.inc(1);
                     }
-                    Err(e) => return Err(e),
                 }
             }
             bar.set_message(format!("{}: measuring {} orders", model.name, ordered.len()));
             let orders: Vec<&Orders> = ordered.iter().map(|(_, e)| &e.orders).collect();
             // Measured together, or where that fails, one by one, so a failure is the method's.
             let together = measure::measure_many(&scene, &orders, &options, raster.as_ref());
-            let mut together = together.map(|m| m.into_iter().map(Ok).collect::<Vec<_>>()).unwrap_or_else(|_| {
+            let together: Vec<Result<_>> = together.map(|m| m.into_iter().map(Ok).collect()).unwrap_or_else(|_| {
                 orders.iter().map(|o| measure::measure(&scene, o, &options, raster.as_ref())).collect()
             });
-            for ((u, mut evaluation), measured) in ordered.into_iter().zip(together.drain(..)) {
+            for ((u, mut evaluation), measured) in ordered.into_iter().zip(together) {
                 let method = &plan.methods[plan.units[u].method];
                 let result = measured.and_then(|measured| {
                     evaluation.measured = measured;
@@ -260,12 +257,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
                         rows.extend(new_rows.into_iter().map(|r| (u, r)));
                         orders_rows.extend(drawn.into_iter().map(|o| (u, o)));
                     }
-                    Err(e) if recorded(&e) => {
-                        let reason = e.to_string();
-                        rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
-                        failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
-                    }
-                    Err(e) => return Err(e),
+                    Err(e) => failed_unit(e, model, method, &context, (u, &mut rows), &mut failures)?,
                 }
                 bar.inc(1);
             }
@@ -302,6 +294,26 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
         }
     };
     Ok(outcome(written, failures, false))
+}
+
+/// `error`, met ordering or measuring `method` on `model` (unit `u`): written as the unit's error
+/// row and listed among the failures when a run records it (a problem of that input), passed on
+/// otherwise.
+fn failed_unit(
+    error: Error,
+    model: &Model,
+    method: &Resolved,
+    context: &Context,
+    (u, rows): (usize, &mut Vec<(usize, Row)>),
+    failures: &mut Vec<Failure>,
+) -> Result<()> {
+    if !recorded(&error) {
+        return Err(error);
+    }
+    let reason = error.to_string();
+    rows.push((u, context.error_row(&model.name, &model.source, Some(method), &reason)));
+    failures.push(Failure { model: model.name.clone(), method: Some(method.canonical()), reason });
+    Ok(())
 }
 
 /// Opens `model` for a run: loads or builds it, says what its report warns of, and simplifies it

@@ -9,7 +9,7 @@
 
 use super::{Draws, MeasureOptions, Metric, Name, Value};
 use crate::error::Result;
-use crate::raster::{ViewCounts, naming_mesh};
+use crate::raster::{OrderPicks, ViewCounts, naming_mesh};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OverdrawSummary {
@@ -105,7 +105,12 @@ impl Metric for Overdraw {
             let triangles = draws.scene.frames.triangles(f, &draws.scene.mesh);
             let counts = draws
                 .raster
-                .count_orders(draws.positions(f), &triangles, &slices, &draws.cameras, &picks, draws.options.res)
+                .count_orders(
+                    draws.positions(f),
+                    &draws.cameras,
+                    &OrderPicks { triangles: &triangles, orders: &slices, picks: &picks },
+                    draws.options.res,
+                )
                 .map_err(|e| naming_mesh(&draws.scene.mesh.name, e))?;
             for (v, counts) in counts.into_iter().enumerate() {
                 for (d, c) in counts.into_iter().enumerate() {

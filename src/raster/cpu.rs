@@ -26,7 +26,7 @@ use rayon::prelude::*;
 
 use super::layers::{self, DepthLayers};
 use super::views::Camera;
-use super::{RasterBackend, ViewCounts};
+use super::{OrderPicks, RasterBackend, ViewCounts};
 use crate::error::{Error, Result};
 
 /// Sub-pixel bits of the snapped vertex coordinates.
@@ -68,15 +68,14 @@ impl RasterBackend for CpuRaster {
     fn count_orders(
         &self,
         positions: &[Vec3],
-        triangles: &[[u32; 3]],
-        orders: &[&[u32]],
         cameras: &[Camera],
-        picks: &[Vec<usize>],
+        draws: &OrderPicks,
         res: u32,
     ) -> Result<Vec<Vec<ViewCounts>>> {
+        let (triangles, orders, picks) = (draws.triangles, draws.orders, draws.picks);
         // A replay is only the same count for a permutation of every triangle.
         if orders.iter().any(|o| o.len() != triangles.len()) {
-            return super::count_each_order(self, positions, triangles, orders, cameras, picks, res);
+            return super::count_each_order(self, positions, cameras, draws, res);
         }
         let ranks: Vec<Vec<u32>> = orders.par_iter().map(|o| layers::ranks(o)).collect();
         each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, v| {

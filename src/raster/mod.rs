@@ -53,37 +53,44 @@ pub trait RasterBackend: Sync {
         res: u32,
     ) -> Result<Vec<ViewCounts>>;
 
-    /// Counts several draw orders of the same `triangles` from each camera: `orders` are
-    /// permutations of the triangles' indices, and `picks[v]` lists the orders (indices into
-    /// `orders`) drawn from camera `v`. Returns, per camera, one count per pick: what
-    /// [`RasterBackend::count`] gives for that order. Several methods measured over one view set
-    /// draw the same triangles from the same cameras, each in its own order; this draws each
-    /// order with the views that pick it, and the CPU backend rasterizes each view once instead.
+    /// Counts several draw orders of the same triangles ([`OrderPicks`]) from each camera:
+    /// per camera, one count per order it picks, what [`RasterBackend::count`] gives for that
+    /// order. Several methods measured over one view set draw the same triangles from the same
+    /// cameras, each in its own order; this draws each order with the views that pick it, and
+    /// the CPU backend rasterizes each view once instead.
     fn count_orders(
         &self,
         positions: &[Vec3],
-        triangles: &[[u32; 3]],
-        orders: &[&[u32]],
         cameras: &[Camera],
-        picks: &[Vec<usize>],
+        draws: &OrderPicks,
         res: u32,
     ) -> Result<Vec<Vec<ViewCounts>>> {
-        count_each_order(self, positions, triangles, orders, cameras, picks, res)
+        count_each_order(self, positions, cameras, draws, res)
     }
+}
+
+/// Several draw orders of one triangle list, and which of them each camera draws: what
+/// [`RasterBackend::count_orders`] counts.
+#[derive(Debug, Clone, Copy)]
+pub struct OrderPicks<'a> {
+    pub triangles: &'a [[u32; 3]],
+    /// Permutations of the triangles' indices.
+    pub orders: &'a [&'a [u32]],
+    /// Per camera, the orders (indices into `orders`) drawn from it.
+    pub picks: &'a [Vec<usize>],
 }
 
 /// [`RasterBackend::count_orders`] by drawing each order with the views that pick it.
 pub fn count_each_order<B: RasterBackend + ?Sized>(
     backend: &B,
     positions: &[Vec3],
-    triangles: &[[u32; 3]],
-    orders: &[&[u32]],
     cameras: &[Camera],
-    picks: &[Vec<usize>],
+    draws: &OrderPicks,
     res: u32,
 ) -> Result<Vec<Vec<ViewCounts>>> {
+    let picks = draws.picks;
     let mut counts: Vec<Vec<ViewCounts>> = picks.iter().map(|p| vec![ViewCounts::default(); p.len()]).collect();
-    for (o, order) in orders.iter().enumerate() {
+    for (o, order) in draws.orders.iter().enumerate() {
         let slots: Vec<(usize, usize)> = picks
             .iter()
             .enumerate()
@@ -92,7 +99,7 @@ pub fn count_each_order<B: RasterBackend + ?Sized>(
         if slots.is_empty() {
             continue;
         }
-        let drawn: Vec<[u32; 3]> = order.iter().map(|&t| triangles[t as usize]).collect();
+        let drawn: Vec<[u32; 3]> = order.iter().map(|&t| draws.triangles[t as usize]).collect();
         let views: Vec<Camera> = slots.iter().map(|&(v, _)| cameras[v]).collect();
         for (&(v, s), c) in slots.iter().zip(backend.count(positions, &drawn, &views, res)?) {
             counts[v][s] = c;
