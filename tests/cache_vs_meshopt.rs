@@ -20,7 +20,7 @@ fn fifo_and_batch_equal_meshopt_on_real_meshes() {
             let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
             let n = mesh.vertex_count();
             let fifo = (3..=64).map(|k| (CacheModel::Fifo(k), (k, 0, 0)));
-            let batch = [(32, 32, 32), (14, 64, 128), (16, 32, 32), (128, 0, 0), (16, 0, 0), (8, 3, 1)]
+            let batch = [(32, 32, 32), (64, 32, 16), (14, 64, 128), (16, 32, 32), (128, 0, 0), (16, 0, 0), (8, 3, 1)]
                 .map(|(c, w, p)| (CacheModel::Batch { cache: c, warp: w, primgroup: p }, (c, w, p)));
             for (model, (c, w, p)) in fifo.chain(batch) {
                 let ours = simulate(model, &triangles, n);

@@ -205,55 +205,125 @@ pub(crate) fn fifo(k: u32, triangles: &[[u32; 3]], vertex_count: usize, mut on_m
 /// submitted and the cache emptied. A repeated corner counts once per corner in that test, as
 /// there.
 ///
-/// Faster than meshoptimizer's loop on large meshes and small (`triorder bench`), for two reasons.
-/// The corners are updated without a branch: on a large mesh whether a corner hits is data, not
-/// a pattern a predictor learns. And the flush test's count of missing corners, a second pass
-/// over the corners, is taken only within three vertices of the warp limit or at the triangle
-/// limit, since three more vertices always fit otherwise: on small meshes timed over and over,
-/// where the predictor does learn the branches of meshoptimizer's loop, that pass was the
-/// difference (branch-free with it: 0.6–0.85× there).
+/// Faster than meshoptimizer's loop on large meshes and small (`triorder bench`), for three
+/// reasons. The corners are updated without a branch: on a large mesh whether a corner hits is
+/// data, not a pattern a predictor learns. The flush test's count of missing corners, a second
+/// pass over the corners, is taken only within three vertices of the warp limit or at the
+/// triangle limit, since three more vertices always fit otherwise. And when the cache holds a
+/// whole warp (`cache ≥ warp`, as in the usual 32/32/32), no vertex can be evicted within a batch,
+/// so a vertex hits exactly when the current batch loaded it ([`BatchLocal`]): its stamp is the
+/// batch's number, a constant between flushes, instead of a miss count that every miss advances,
+/// which chains each corner's test to the one before.
 fn batch(
     k: u32,
     warp: u32,
     primgroup: u32,
     triangles: &[[u32; 3]],
     vertex_count: usize,
-    mut on_miss: impl FnMut(usize),
+    on_miss: impl FnMut(usize),
 ) -> CacheStats {
     // A disabled limit becomes one no batch can reach, which keeps the loop free of extra tests.
     let off_is_max = |limit: u32| if limit == 0 { u32::MAX } else { limit };
     let (warp, primgroup) = (off_is_max(warp), off_is_max(primgroup));
+    if k >= warp {
+        batches(BatchLocal { batch: 1 }, warp, primgroup, triangles, vertex_count, on_miss)
+    } else {
+        batches(Fifo { k, now: k + 1 }, warp, primgroup, triangles, vertex_count, on_miss)
+    }
+}
+
+/// When a vertex stamped `stamp` is still cached, for [`batches`]. A stamp of 0 is a vertex never
+/// loaded, and must read as not cached.
+trait Residency {
+    fn cached(&self, stamp: u32) -> bool;
+    /// The stamp of a vertex after a corner referenced it (`miss`: it was loaded), and the
+    /// corner's effect on the rule.
+    fn referenced(&mut self, stamp: u32, miss: bool) -> u32;
+    /// The cache is emptied.
+    fn flush(&mut self);
+}
+
+/// A FIFO of `k` entries by timestamps: a vertex is cached iff it entered among the last `k`
+/// misses (see [`fifo`]).
+struct Fifo {
+    k: u32,
+    now: u32,
+}
+
+impl Residency for Fifo {
+    fn cached(&self, stamp: u32) -> bool {
+        self.now - stamp <= self.k
+    }
+
+    fn referenced(&mut self, stamp: u32, miss: bool) -> u32 {
+        let stamp = if miss { self.now } else { stamp };
+        self.now += u32::from(miss);
+        stamp
+    }
+
+    fn flush(&mut self) {
+        self.now += self.k + 1;
+    }
+}
+
+/// A cache that holds everything the current batch loaded: stamps are batch numbers.
+struct BatchLocal {
+    batch: u32,
+}
+
+impl Residency for BatchLocal {
+    fn cached(&self, stamp: u32) -> bool {
+        stamp == self.batch
+    }
+
+    fn referenced(&mut self, _: u32, _: bool) -> u32 {
+        self.batch
+    }
+
+    fn flush(&mut self) {
+        self.batch += 1;
+    }
+}
+
+/// The batch model's loop ([`batch`]) over a cache `rule`; `warp` and `primgroup` are limits
+/// (`u32::MAX`: none).
+fn batches(
+    mut rule: impl Residency,
+    warp: u32,
+    primgroup: u32,
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    mut on_miss: impl FnMut(usize),
+) -> CacheStats {
     let mut stamp = vec![0u32; vertex_count];
-    let mut now = k + 1;
     let (mut misses, mut batches) = (0u64, 0u64);
     let (mut in_warp, mut in_group) = (0u32, 0u32);
     for (t, tri) in triangles.iter().enumerate() {
         // The flush test needs the triangle's missing corners only near a limit: three more
         // vertices fit otherwise. Far from one (most triangles) only the corners are updated.
         if in_group == primgroup || in_warp.saturating_add(3) > warp {
-            let missing: u32 = tri.iter().map(|&v| u32::from(now - stamp[v as usize] > k)).sum();
+            let missing: u32 = tri.iter().map(|&v| u32::from(!rule.cached(stamp[v as usize]))).sum();
             if in_group == primgroup || in_warp.saturating_add(missing) > warp {
                 batches += u64::from(in_warp > 0);
+                misses += u64::from(in_warp);
                 in_warp = 0;
                 in_group = 0;
-                now += k + 1;
+                rule.flush();
             }
         }
-        let before = now;
         for (corner, &v) in tri.iter().enumerate() {
-            let s = stamp[v as usize];
-            let miss = now - s > k;
-            stamp[v as usize] = if miss { now } else { s };
-            now += u32::from(miss);
+            let s = &mut stamp[v as usize];
+            let miss = !rule.cached(*s);
+            *s = rule.referenced(*s, miss);
+            in_warp += u32::from(miss);
             if miss {
                 on_miss(3 * t + corner);
             }
         }
-        in_warp += now - before;
-        misses += u64::from(now - before);
         in_group += 1;
     }
     batches += u64::from(in_warp > 0);
+    misses += u64::from(in_warp);
     CacheStats { triangles: triangles.len(), vertices: stamp.iter().filter(|&&s| s != 0).count(), misses, batches }
 }
 
