@@ -5,8 +5,9 @@
 //! clip to its own buffers and `mode=joint` to k in all; same seed, same result; the k-means
 //! iteration cap and the `converged` flag; view clustering on a static mesh lowers overdraw;
 //! `tipsify-per-frame`'s buffer f is `sander07` on the mesh posed at frame f; evaluation views are
-//! not optimization views; the lookup returns a node's own buffer from the node's direction; and
-//! linear blend skinning of RiggedSimple against a pose computed by hand from the file.
+//! not optimization views; the lookup returns a node's own buffer from the node's direction;
+//! linear blend skinning of RiggedSimple against a pose computed by hand from the file; and hs17
+//! orderings of one scene sharing its rasterized nodes.
 //!
 //! Tests on the shared models return early (pass) when the data directory is absent.
 
@@ -135,6 +136,36 @@ fn same_seed_same_buffers_and_lookup() {
     let implicit = resolved.ordering.order(&scene).unwrap();
     let explicit = orders_of("hs17:views=12,res=32,seed=7", &scene);
     assert!(implicit.buffers == explicit.buffers && implicit.lookup == explicit.lookup);
+}
+
+/// hs17 orderings of one scene rasterize its nodes once: a second ordering with other settings
+/// but the same viewpoints and resolution reuses them, gives what it gives on a fresh scene, and
+/// charges the reused rasterization to its own time, at what it cost the first; one with other
+/// viewpoints rasterizes its own.
+#[test]
+#[cfg_attr(not(triorder_data), ignore = "needs the shared models: ../shared/data or TRIORDER_DATA (README, Data)")]
+fn hs17_orderings_of_one_scene_share_its_rasterized_nodes() {
+    let scene = animation("Fox.glb", None, 3);
+    let first = orders_of("hs17:views=42,res=32", &scene);
+    assert_eq!(first.reused, 0.0, "the first ordering rasterizes its nodes");
+    let phase = |o: &Orders| o.phases.iter().find(|(p, _)| *p == "rasterization").expect("a rasterization phase").1;
+    for spec in ["hs17:views=42,res=32,lambda=3", "hs17:views=42,res=32,mode=joint,seed=4"] {
+        let reusing = orders_of(spec, &scene);
+        let fresh = orders_of(spec, &animation("Fox.glb", None, 3));
+        assert!(reusing.buffers == fresh.buffers && reusing.lookup == fresh.lookup, "{spec}: reuse changed the result");
+        assert_eq!(fresh.reused, 0.0);
+        // The nodes reused, at what rasterizing them took the first run (its phase also holds
+        // sorting the initial buffers).
+        assert!(
+            reusing.reused > 0.0 && reusing.reused <= phase(&first),
+            "{spec}: {} vs {}",
+            reusing.reused,
+            phase(&first)
+        );
+        assert!(phase(&reusing) >= reusing.reused, "{spec}: the reused time is charged to the phase");
+    }
+    assert_eq!(orders_of("hs17:views=12,res=32", &scene).reused, 0.0, "other viewpoints, other nodes");
+    assert_eq!(orders_of("hs17:views=42,res=64", &scene).reused, 0.0, "another resolution, other nodes");
 }
 
 /// The iteration cap: a run that needs n rounds converges, and reports it, when allowed n; capped

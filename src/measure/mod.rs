@@ -401,7 +401,7 @@ pub fn order_timed(scene: &Scene, method: &Resolved, options: &MeasureOptions) -
     let start = Instant::now();
     let orders =
         if options.per_draw_call { order::draw_calls::run(method, scene)? } else { order::run(method, scene)? };
-    let seconds = start.elapsed().as_secs_f64();
+    let seconds = start.elapsed().as_secs_f64() + orders.reused;
     Ok(Evaluation {
         method: method.canonical(),
         method_name: method.method.name,

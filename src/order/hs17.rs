@@ -44,6 +44,7 @@
 //! 1e30 model was refused as needing clipping.
 
 use std::ops::Range;
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::Vec3;
@@ -54,6 +55,7 @@ use super::sander07::{LAMBDA, patches};
 use super::tipsify::FIFO_CACHE;
 use super::{Clustered, Lookup, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
+use crate::mesh::scene::SharedWork;
 use crate::mesh::{Frames, Scene};
 use crate::raster::cpu::depth_layers;
 use crate::raster::layers::{DepthLayers, ranks};
@@ -154,6 +156,7 @@ impl Ordering for Hs17 {
         let cameras: Vec<Camera> = directions.iter().map(|&d| perspective(keyframes.framing, d)).collect();
         let scene = Nodes {
             name: &scene.mesh.name,
+            shared: &scene.shared,
             triangles: &scene.mesh.triangles,
             keyframes,
             patches: &patches,
@@ -167,9 +170,10 @@ impl Ordering for Hs17 {
 
         let mut buffers: Vec<Clustered> = Vec::new();
         let mut assignment = vec![0u16; keyframes.len() * cameras.len()];
-        let (mut iterations, mut converged) = (0, true);
+        let (mut iterations, mut converged, mut reused) = (0, true, 0.0);
         for frames in groups {
             let result = self.kmeans(&scene, frames.clone(), &mut clock)?;
+            reused += result.reused;
             iterations = iterations.max(result.iterations);
             converged &= result.converged;
             // Keep the buffers some node uses, numbered after the previous groups' buffers.
@@ -187,7 +191,7 @@ impl Ordering for Hs17 {
             }
         }
         let lookup = Lookup::nearest(&directions, &assignment);
-        Ok(Orders { buffers, lookup, iterations: Some(iterations), converged, phases: clock.phases })
+        Ok(Orders { buffers, lookup, iterations: Some(iterations), converged, phases: clock.phases, reused })
     }
 }
 
@@ -195,6 +199,8 @@ impl Ordering for Hs17 {
 struct Nodes<'a> {
     /// The mesh's name, for errors.
     name: &'a str,
+    /// Where the scene's rasterized nodes are kept for the other hs17 orderings of it.
+    shared: &'a SharedWork,
     triangles: &'a [[u32; 3]],
     keyframes: &'a Frames,
     patches: &'a Clustered,
@@ -224,6 +230,8 @@ struct KMeans {
     assignment: Vec<u16>,
     iterations: usize,
     converged: bool,
+    /// Seconds of node rasterization reused from an earlier ordering of the scene.
+    reused: f64,
 }
 
 impl Hs17 {
@@ -241,8 +249,10 @@ impl Hs17 {
             .iter()
             .map(|&v| scene.buffer(&sort_by_key(&average, |c| c.distance(scene.cameras[v].unit_eye()))))
             .collect();
-        let nodes = rasterize_nodes(scene, frames.clone(), self.res)?;
+        let (frame_nodes, reused) = rasterize_nodes(scene, frames.clone(), self.res)?;
+        let nodes: Vec<&DepthLayers> = frame_nodes.iter().flat_map(|f| f.iter()).collect();
         clock.lap("rasterization");
+        clock.charge("rasterization", reused);
         let mut assignment: Vec<u16> = vec![u16::MAX; nodes.len()];
         // Step 2's integrated distance d(p) of every patch for every cluster (patch-major:
         // `integrated[p × k + c]`), summed over the nodes `counted` in that cluster.
@@ -270,7 +280,7 @@ impl Hs17 {
             let converged = settled || stalled == STALL_ROUNDS;
             if converged || iteration == self.max_iterations {
                 let (_, buffers, assignment) = best.expect("one round has run");
-                return Ok(KMeans { buffers, assignment, iterations: iteration, converged });
+                return Ok(KMeans { buffers, assignment, iterations: iteration, converged, reused });
             }
             // Step 2 for the clusters whose nodes changed: the integrated distances follow the
             // nodes that moved (a few percent of them after the first rounds), so a round costs
@@ -364,24 +374,31 @@ fn patch_centroids(scene: &Nodes, frames: Range<usize>) -> Vec<Vec3> {
         .collect()
 }
 
-/// Every node of `frames` rasterized once: node `(f − first) × views + v` is frame f seen by
-/// camera v. The depth test of any buffer is then replayed from these
-/// ([`DepthLayers::contested_passes`]).
-fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<Vec<DepthLayers>> {
-    let mut nodes = Vec::with_capacity(frames.len() * scene.cameras.len());
-    for f in frames {
-        nodes.extend(
-            depth_layers(&scene.keyframes.frames[f], scene.triangles, scene.cameras, res)
-                .map_err(|e| naming_mesh(scene.name, e))?,
-        );
-    }
-    Ok(nodes)
+/// Every node of `frames` rasterized once, per frame: node `(f − first) × views + v` is frame f
+/// seen by camera v. The depth test of any buffer is then replayed from these
+/// ([`DepthLayers::contested_passes`]). A frame's nodes are rasterized by the first hs17 ordering
+/// of the scene that needs them and kept for the others (every λ, mode, seed and cluster count
+/// draws the same nodes); also returns the seconds that reusing them saved, as they cost then.
+fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<(Vec<Arc<Vec<DepthLayers>>>, f64)> {
+    let mut reused = 0.0;
+    let nodes = frames
+        .map(|f| {
+            let key = format!("hs17 nodes: frame {f}, {} viewpoints, {res}²", scene.cameras.len());
+            let (nodes, saved) = scene.shared.get_or_compute(&key, || {
+                depth_layers(&scene.keyframes.frames[f], scene.triangles, scene.cameras, res)
+                    .map_err(|e| naming_mesh(scene.name, e))
+            })?;
+            reused += saved.unwrap_or(0.0);
+            Ok(nodes)
+        })
+        .collect::<Result<_>>()?;
+    Ok((nodes, reused))
 }
 
 /// Step 1: each node to the buffer with the fewest passing fragments; a node keeps its
 /// `previous` buffer when that one ties for the fewest. Also returns those fewest fragments
 /// summed over the nodes: what the assignment minimizes.
-fn assign(nodes: &[DepthLayers], buffers: &[Clustered], previous: &[u16]) -> (Vec<u16>, u64) {
+fn assign(nodes: &[&DepthLayers], buffers: &[Clustered], previous: &[u16]) -> (Vec<u16>, u64) {
     let ranks: Vec<Vec<u32>> = buffers.par_iter().map(|b| ranks(&b.order)).collect();
     let chosen: Vec<(u16, u32)> = nodes
         .par_iter()
@@ -412,6 +429,11 @@ impl Clock {
         let now = Instant::now();
         let seconds = now.duration_since(self.last).as_secs_f64();
         self.last = now;
+        self.charge(phase, seconds);
+    }
+
+    /// Adds `seconds` to `phase`.
+    fn charge(&mut self, phase: &'static str, seconds: f64) {
         match self.phases.iter_mut().find(|(p, _)| *p == phase) {
             Some((_, s)) => *s += seconds,
             None => self.phases.push((phase, seconds)),

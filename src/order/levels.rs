@@ -73,6 +73,7 @@ pub fn run(resolved: &Resolved, scene: &Scene, levels: &Levels) -> Result<Orders
         iterations: None,
         converged: true,
         phases,
+        reused: 0.0,
     })
 }
 

@@ -151,6 +151,10 @@ pub struct Orders {
     pub converged: bool,
     /// Where the ordering's time went: `(phase, seconds)`, for methods that say.
     pub phases: Vec<(&'static str, f64)>,
+    /// Seconds of work an earlier ordering of the same scene had done and this one reused
+    /// ([`crate::mesh::scene::SharedWork`]), at what it cost then: added to the time the ordering
+    /// is reported to take, so that it is the time it takes on its own.
+    pub reused: f64,
 }
 
 impl Orders {
@@ -166,7 +170,14 @@ impl Orders {
 /// One buffer, drawn for every frame from every direction.
 impl From<Clustered> for Orders {
     fn from(buffer: Clustered) -> Orders {
-        Orders { buffers: vec![buffer], lookup: Lookup::uniform(), iterations: None, converged: true, phases: vec![] }
+        Orders {
+            buffers: vec![buffer],
+            lookup: Lookup::uniform(),
+            iterations: None,
+            converged: true,
+            phases: vec![],
+            reused: 0.0,
+        }
     }
 }
 

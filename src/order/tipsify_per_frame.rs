@@ -51,6 +51,6 @@ impl Ordering for TipsifyPerFrame {
             })
             .collect();
         let frame_ids: Vec<u16> = (0..scene.frames.len()).map(|f| f as u16).collect();
-        Ok(Orders { buffers, lookup: Lookup::per_frame(&frame_ids), iterations: None, converged: true, phases: vec![] })
+        Ok(Orders { buffers, lookup: Lookup::per_frame(&frame_ids), iterations: None, converged: true, phases: vec![], reused: 0.0 })
     }
 }

@@ -78,7 +78,9 @@ pub struct Row {
     pub view: Option<usize>,
     pub backend: String,
     pub value: f64,
-    /// Wall time of the ordering alone.
+    /// Wall time of the ordering alone: work it reused from an earlier ordering of the same
+    /// scene (hs17's rasterized nodes) is counted at what it cost then
+    /// ([`crate::order::Orders::reused`]).
     pub seconds: f64,
     pub machine: String,
     pub commit: String,

@@ -84,6 +84,7 @@ impl Ordering for PerView {
             iterations: None,
             converged: true,
             phases: vec![],
+            reused: 0.0,
         })
     }
 }
