@@ -58,7 +58,7 @@ use crate::error::{Error, Result};
 use crate::mesh::scene::SharedWork;
 use crate::mesh::{Frames, Scene};
 use crate::raster::cpu::depth_layers;
-use crate::raster::layers::{DepthLayers, ranks};
+use crate::raster::layers::{DepthLayers, LaneRanks};
 use crate::raster::naming_mesh;
 use crate::raster::views::{Camera, icosphere_directions, perspective};
 
@@ -399,12 +399,13 @@ fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<(Vec
 /// `previous` buffer when that one ties for the fewest. Also returns those fewest fragments
 /// summed over the nodes: what the assignment minimizes.
 fn assign(nodes: &[&DepthLayers], buffers: &[Clustered], previous: &[u16]) -> (Vec<u16>, u64) {
-    let ranks: Vec<Vec<u32>> = buffers.par_iter().map(|b| ranks(&b.order)).collect();
+    let orders: Vec<&[u32]> = buffers.iter().map(|b| b.order.as_slice()).collect();
+    let ranks = LaneRanks::new(&orders);
     let chosen: Vec<(u16, u32)> = nodes
         .par_iter()
         .zip(previous)
         .map(|(node, &before)| {
-            let passed: Vec<u32> = ranks.iter().map(|rank| node.contested_passes(rank)).collect();
+            let passed = node.contested_passes_all(&ranks);
             let best = *passed.iter().min().expect("at least one buffer");
             let keep = passed.get(usize::from(before)).is_some_and(|&p| p == best);
             (if keep { before } else { passed.iter().position(|&p| p == best).unwrap() as u16 }, best)

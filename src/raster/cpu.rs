@@ -24,7 +24,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::layers::{self, DepthLayers};
+use super::layers::{self, DepthLayers, LaneRanks};
 use super::views::Camera;
 use super::{OrderPicks, RasterBackend, ViewCounts};
 use crate::error::{Error, Result};
@@ -76,6 +76,14 @@ impl RasterBackend for CpuRaster {
         // A replay is only the same count for a permutation of every triangle.
         if orders.iter().any(|o| o.len() != triangles.len()) {
             return super::count_each_order(self, positions, cameras, draws, res);
+        }
+        // Where every view draws the same orders (every order of a static method), they are
+        // replayed side by side ([`LaneRanks`]); else each view's picks one by one.
+        if let Some(same) = picks.first().filter(|first| picks.iter().all(|p| p == *first)) {
+            let ranks = LaneRanks::new(&same.iter().map(|&o| orders[o]).collect::<Vec<_>>());
+            return each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, _| {
+                scratch.layers(screen, triangles, res).counts_all(&ranks)
+            });
         }
         let ranks: Vec<Vec<u32>> = orders.par_iter().map(|o| layers::ranks(o)).collect();
         each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, v| {

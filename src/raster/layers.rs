@@ -13,6 +13,8 @@
 //! every k-means round on its nodes, and the CPU backend counts every method's order of one
 //! scene from one rasterization per view ([`super::cpu::CpuRaster`]'s `count_orders`).
 
+use rayon::prelude::*;
+
 use super::ViewCounts;
 use super::cpu::Fragment;
 
@@ -54,8 +56,12 @@ impl DepthLayers {
         for f in fragments.iter().filter(can_pass) {
             slots[f.pixel as usize - first + 1] += 1;
         }
-        for p in 0..span {
-            slots[p + 1] += slots[p];
+        // Pixel i's start, from a running sum in a register: summing in place, each slot would
+        // wait on the store of the one before (12% of building a view's layers).
+        let mut running = 0;
+        for slot in slots.iter_mut() {
+            running += *slot;
+            *slot = running;
         }
         // Scattered with each pixel's start as its cursor, which leaves it at the pixel's end.
         let mut by_pixel = vec![(0.0f32, 0u32); slots[span] as usize];
@@ -85,22 +91,47 @@ impl DepthLayers {
     /// Fragments passing the depth test over the contested pixels when triangle t is drawn
     /// `rank[t]`-th.
     pub fn contested_passes(&self, rank: &[u32]) -> u32 {
-        let mut passed = 0;
+        self.replay(|t| [rank[t]])[0]
+    }
+
+    /// [`DepthLayers::contested_passes`] of every order of `ranks`, in order: one scan of the
+    /// layers per [`LANES`] orders, with one memory access for a triangle's ranks in all of them.
+    /// Replaying many orders on many views (hs17's k buffers on every node, every round; every
+    /// method of a run on every view) is bound by those accesses.
+    pub fn contested_passes_all(&self, ranks: &LaneRanks) -> Vec<u32> {
+        let mut passed = Vec::with_capacity(ranks.orders);
+        for (chunk, lanes) in ranks.chunks.iter().enumerate() {
+            let used = (ranks.orders - chunk * LANES).min(LANES);
+            passed.extend_from_slice(&self.replay(|t| lanes[t])[..used]);
+        }
+        passed
+    }
+
+    /// The depth test of `L` orders over the contested pixels, `rank(t)` giving triangle t's rank
+    /// in each.
+    fn replay<const L: usize>(&self, rank: impl Fn(usize) -> [u32; L]) -> [u32; L] {
+        let mut passed = [0u32; L];
         for w in self.starts.windows(2) {
             let entries = &self.triangles[w[0] as usize..w[1] as usize];
             // The earliest draw among strictly nearer fragments, and among those at this depth.
-            let (mut nearer, mut group) = (u32::MAX, u32::MAX);
+            let (mut nearer, mut group) = ([u32::MAX; L], [u32::MAX; L]);
             for &entry in entries {
-                let r = rank[(entry & !TIED) as usize];
+                let r = rank((entry & !TIED) as usize);
                 if entry & TIED == 0 {
-                    passed += u32::from(group < nearer);
-                    nearer = nearer.min(group);
-                    group = r;
+                    for l in 0..L {
+                        passed[l] += u32::from(group[l] < nearer[l]);
+                        nearer[l] = nearer[l].min(group[l]);
+                        group[l] = r[l];
+                    }
                 } else {
-                    group = group.min(r);
+                    for l in 0..L {
+                        group[l] = group[l].min(r[l]);
+                    }
                 }
             }
-            passed += u32::from(group < nearer);
+            for l in 0..L {
+                passed[l] += u32::from(group[l] < nearer[l]);
+            }
         }
         passed
     }
@@ -108,10 +139,49 @@ impl DepthLayers {
     /// The view's counts when triangle t is drawn `rank[t]`-th: what drawing them in that order
     /// into a cleared depth buffer counts.
     pub fn counts(&self, rank: &[u32]) -> ViewCounts {
+        self.with_contested(self.contested_passes(rank))
+    }
+
+    /// [`DepthLayers::counts`] of every order of `ranks`, in order.
+    pub fn counts_all(&self, ranks: &LaneRanks) -> Vec<ViewCounts> {
+        self.contested_passes_all(ranks).into_iter().map(|p| self.with_contested(p)).collect()
+    }
+
+    /// The view's counts when `contested` fragments pass over its contested pixels.
+    fn with_contested(&self, contested: u32) -> ViewCounts {
         ViewCounts {
             covered: self.singles + (self.starts.len() - 1) as u64,
-            passed: self.singles + u64::from(self.contested_passes(rank)),
+            passed: self.singles + u64::from(contested),
         }
+    }
+}
+
+/// Orders replayed together by one scan of [`DepthLayers::contested_passes_all`].
+const LANES: usize = 8;
+
+/// Several permutations of the same triangles as ranks side by side, [`LANES`] orders a chunk:
+/// `chunks[c][t][i]` is triangle t's rank in order `c × LANES + i`; lanes past the last order
+/// repeat the chunk's first.
+pub struct LaneRanks {
+    chunks: Vec<Vec<[u32; LANES]>>,
+    orders: usize,
+}
+
+impl LaneRanks {
+    pub fn new(orders: &[&[u32]]) -> LaneRanks {
+        let chunks = orders
+            .par_chunks(LANES)
+            .map(|chunk| {
+                let mut rank = vec![[0; LANES]; chunk[0].len()];
+                for lane in 0..LANES {
+                    for (i, &t) in chunk[lane.min(chunk.len() - 1)].iter().enumerate() {
+                        rank[t as usize][lane] = i as u32;
+                    }
+                }
+                rank
+            })
+            .collect();
+        LaneRanks { chunks, orders: orders.len() }
     }
 }
 
