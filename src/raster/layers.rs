@@ -136,6 +136,11 @@ impl DepthLayers {
         passed
     }
 
+    /// Each contested pixel's fragments, nearest first, as runs of triangles at one depth.
+    pub fn contested(&self) -> impl Iterator<Item = Contested<'_>> {
+        self.starts.windows(2).map(|w| Contested { entries: &self.triangles[w[0] as usize..w[1] as usize] })
+    }
+
     /// The view's counts when triangle t is drawn `rank[t]`-th: what drawing them in that order
     /// into a cleared depth buffer counts.
     pub fn counts(&self, rank: &[u32]) -> ViewCounts {
@@ -153,6 +158,28 @@ impl DepthLayers {
             covered: self.singles + (self.starts.len() - 1) as u64,
             passed: self.singles + u64::from(contested),
         }
+    }
+}
+
+/// One contested pixel of a [`DepthLayers`]: its fragments' triangles, nearest first.
+#[derive(Clone, Copy)]
+pub struct Contested<'a> {
+    entries: &'a [u32],
+}
+
+impl<'a> Contested<'a> {
+    /// Every fragment's triangle, nearest first (ties in their sorted order).
+    pub fn triangles(self) -> impl Iterator<Item = u32> + 'a {
+        self.entries.iter().map(|&e| e & !TIED)
+    }
+
+    /// Per fragment, nearest first: its triangle and the index of its depth among the pixel's
+    /// distinct depths (equal for fragments at one depth, rising with depth).
+    pub fn by_depth(self) -> impl Iterator<Item = (u32, u32)> + 'a {
+        self.entries.iter().scan(0u32, |depth, &e| {
+            *depth += u32::from(e & TIED == 0);
+            Some((e & !TIED, *depth - 1))
+        })
     }
 }
 

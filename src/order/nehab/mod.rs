@@ -24,7 +24,7 @@ pub mod overdraw_graph;
 pub(crate) mod planar_clusters;
 
 use feedback_arc_set::greedy_order;
-use overdraw_graph::{ClusteredDraw, one_pass};
+use overdraw_graph::{ClusteredDraw, from_layers, one_pass};
 use planar_clusters::planar_clusters;
 use rayon::prelude::*;
 
@@ -35,7 +35,7 @@ use crate::mesh::Framing;
 use crate::mesh::{Mesh, Scene};
 use crate::measure::OverdrawSummary;
 use crate::raster::cpu::depth_layers;
-use crate::raster::layers::ranks;
+use crate::raster::layers::{DepthLayers, ranks};
 use crate::raster::{ViewCounts, ViewSet, naming_mesh};
 
 const CLUSTERS: ParamInfo = ParamInfo {
@@ -123,12 +123,12 @@ struct Nehab {
 impl Ordering for Nehab {
     fn order(&self, scene: &Scene) -> Result<Orders> {
         if !self.doubling {
-            return self.order_with(scene, self.clusters).map(Orders::from);
+            return self.order_with(scene, self.clusters, None).map(Orders::from);
         }
         let mesh = &scene.mesh;
         let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
         // Every count's order draws the same triangles from the same views: each view is
-        // rasterized once and each order's depth test replayed from it (the counts drawing the
+        // rasterized once, and each order's graph and depth test taken from it (what drawing the
         // order would give).
         let layers =
             depth_layers(&mesh.positions, &mesh.triangles, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?;
@@ -141,7 +141,7 @@ impl Ordering for Nehab {
         let mut tried: Vec<(Clustered, f64)> = Vec::new();
         let mut k = 1;
         loop {
-            let order = self.order_with(scene, k)?;
+            let order = self.order_with(scene, k, Some(&layers))?;
             let ovr = mean_ovr(&order)?;
             tried.push((order, ovr));
             let n = tried.len();
@@ -166,8 +166,9 @@ impl Ordering for Nehab {
 }
 
 impl Nehab {
-    /// The order with `target` planar clusters.
-    fn order_with(&self, scene: &Scene, target: usize) -> Result<Clustered> {
+    /// The order with `target` planar clusters; its graph from `layers` where the views of the
+    /// mesh have been rasterized already (their [`DepthLayers`]), else from rasterizing them.
+    fn order_with(&self, scene: &Scene, target: usize, layers: Option<&[DepthLayers]>) -> Result<Clustered> {
         let mesh = &scene.mesh;
         let clusters = planar_clusters(mesh, &scene.topology, target, self.seed);
         let members = members(&clusters.cluster, clusters.count);
@@ -175,10 +176,15 @@ impl Nehab {
         let inner_orders: Vec<Order> =
             members.par_iter().map(|tris| order_inside(mesh, tris, inner.ordering.as_ref())).collect::<Result<_>>()?;
         let local = Clustered::concat(inner_orders.iter().map(Vec::as_slice));
-        let triangles = mesh.triangles_in_order(&local.order);
-        let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &local.starts };
-        let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
-        let graph = one_pass(draw, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?;
+        let graph = match layers {
+            Some(layers) => from_layers(layers, &ranks(&local.order), &clusters.cluster, clusters.count),
+            None => {
+                let triangles = mesh.triangles_in_order(&local.order);
+                let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &local.starts };
+                let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
+                one_pass(draw, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?
+            }
+        };
         let sequence = greedy_order(clusters.count, &graph.arcs());
         Ok(Clustered::concat(sequence.iter().map(|&c| inner_orders[c as usize].as_slice())))
     }

@@ -17,22 +17,24 @@
 //! b's alone-passing fragments at or behind a's nearest depth,
 //!
 //! and the graph is the antisymmetric part of the matrix `saved`, summed over pixels and views.
-//! The fragments of one view are bucketed by pixel with a stable counting sort, which keeps draw
-//! order inside each pixel; since the triangles are drawn cluster after cluster, each pixel's list
-//! is already grouped by cluster. Work per view is O(fragments + pixels + Σ per-pixel clusters²).
-//! [`pair_by_pair`] is the paper's method, kept as the test oracle: the two agree exactly.
+//! Only pixels reached by two or more fragments can hold a pair, and those are what a view's
+//! [`DepthLayers`] keep, each sorted by depth: walking one nearest first, a cluster's fragments at
+//! one depth pass alone when the earliest drawn of them is drawn before every nearer one of the
+//! cluster. So the graph of any draw order of the same triangles is counted from the same layers
+//! ([`from_layers`]): `nehab`'s search over cluster counts rasterizes each view once for every
+//! count it tries. Work per view is O(fragments) to rasterize and sort, then per contested pixel
+//! O(fragments × clusters there). [`pair_by_pair`] is the paper's method, kept as the test oracle:
+//! the two agree exactly.
 //!
-//! Memory: one n×n matrix of u64 per worker thread plus, per thread, one view's fragments
-//! (16 bytes each, twice) and a pixel index (4 bytes per pixel), whatever the number of views.
-//! For the 202k dragon at 642 views and 512², the whole `triorder eval` peaks at 77 MB resident
-//! with 64 clusters and 99 MB with 1024 (2 threads), of which 73 MB is the loaded mesh and its
-//! topology (the peak of ordering it with `hoppe`).
+//! Memory: one n×n matrix of u64 per worker thread, plus the layers of the views being counted:
+//! [`one_pass`] rasterizes 16 views at a time.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::raster::cpu::{self, CpuRaster, Fragment};
+use crate::raster::cpu::{CpuRaster, depth_layers};
+use crate::raster::layers::{Contested, DepthLayers};
 use crate::raster::{Camera, RasterBackend};
 
 /// Clusters as contiguous runs of a draw list: cluster `c` is `triangles[starts[c]..starts[c + 1]]`,
@@ -106,94 +108,109 @@ impl OverdrawGraph {
     }
 }
 
-/// The graph from one rasterization per camera (views in parallel).
+/// The graph from one rasterization per camera: each view's fragments as [`DepthLayers`] (a few
+/// views at a time, in parallel), then [`from_layers`].
 pub fn one_pass(draw: ClusteredDraw, cameras: &[Camera], res: u32) -> Result<OverdrawGraph> {
     let n = draw.cluster_count();
     let mut cluster_of = vec![0u32; draw.triangles.len()];
     for c in 0..n {
         cluster_of[draw.starts[c]..draw.starts[c + 1]].fill(c as u32);
     }
+    // The triangles are listed in draw order.
+    let rank: Vec<u32> = (0..draw.triangles.len() as u32).collect();
+    let mut graph = OverdrawGraph::zero(n);
+    for views in cameras.chunks(VIEWS_AT_ONCE) {
+        let layers = depth_layers(draw.positions, draw.triangles, views, res)?;
+        graph = graph.add(from_layers(&layers, &rank, &cluster_of, n));
+    }
+    Ok(graph)
+}
+
+/// Views whose layers [`one_pass`] holds at once: enough to keep both threads busy, few enough
+/// that memory does not grow with the view set.
+const VIEWS_AT_ONCE: usize = 16;
+
+/// The graph of `n` clusters (`cluster_of[t]`: triangle t's) drawn in the order `rank` (`rank[t]`:
+/// triangle t's place), from views of those triangles already rasterized ([`DepthLayers`], views
+/// in parallel). Every order of the same triangles from the same views is counted from the same
+/// layers: `nehab`'s search over cluster counts rasterizes each view once for all of them.
+pub fn from_layers(layers: &[DepthLayers], rank: &[u32], cluster_of: &[u32], n: usize) -> OverdrawGraph {
     // One run of views per worker thread, so only that many n×n matrices ever exist.
-    let per_thread = cameras.len().div_ceil(rayon::current_num_threads()).max(1);
-    cameras
+    let per_thread = layers.len().div_ceil(rayon::current_num_threads()).max(1);
+    layers
         .par_iter()
         .with_min_len(per_thread)
-        .try_fold(
-            || (OverdrawGraph::zero(n), ViewScratch::default()),
-            |(mut graph, mut scratch), camera| {
-                cpu::fragments(draw.positions, draw.triangles, camera, res, &mut scratch.fragments)?;
-                scratch.accumulate(&cluster_of, res, &mut graph);
-                Ok((graph, scratch))
+        .fold(
+            || (OverdrawGraph::zero(n), PixelScratch::default()),
+            |(mut graph, mut scratch), view| {
+                for pixel in view.contested() {
+                    scratch.accumulate(pixel, rank, cluster_of, &mut graph);
+                }
+                (graph, scratch)
             },
         )
-        .map(|partial| partial.map(|(graph, _)| graph))
-        .try_reduce(|| OverdrawGraph::zero(n), |a, b| Ok(a.add(b)))
+        .map(|(graph, _)| graph)
+        .reduce(|| OverdrawGraph::zero(n), OverdrawGraph::add)
 }
 
-/// Per-thread buffers reused across views.
+/// One contested pixel's clusters, reused from pixel to pixel.
 #[derive(Default)]
-struct ViewScratch {
-    fragments: Vec<Fragment>,
-    /// Fragments bucketed by pixel, draw order kept: `(cluster, depth)`.
-    by_pixel: Vec<(u32, f32)>,
-    /// Start of each pixel's bucket in `by_pixel`.
-    pixel_start: Vec<u32>,
-    /// Next free slot of each pixel's bucket while filling.
-    cursor: Vec<u32>,
-    /// The current pixel's clusters: `(cluster, nearest depth, range of its alone-passing depths)`.
-    groups: Vec<(u32, f32, usize, usize)>,
-    passing: Vec<f32>,
+struct PixelScratch {
+    clusters: Vec<Present>,
+    /// The alone-passing fragments: their cluster and depth index.
+    passing: Vec<(u32, u32)>,
 }
 
-impl ViewScratch {
-    fn accumulate(&mut self, cluster_of: &[u32], res: u32, graph: &mut OverdrawGraph) {
-        let pixels = res as usize * res as usize;
-        // Stable counting sort of the fragments by pixel.
-        self.pixel_start.clear();
-        self.pixel_start.resize(pixels + 1, 0);
-        for f in &self.fragments {
-            self.pixel_start[f.pixel as usize + 1] += 1;
+/// A cluster at the pixel, its fragments walked nearest first.
+struct Present {
+    cluster: u32,
+    /// The depth index of its nearest fragment.
+    nearest: u32,
+    /// Its earliest draw among fragments strictly nearer than `depth`.
+    before: u32,
+    /// Its earliest draw at `depth`, the depth of its fragments being walked.
+    at: u32,
+    depth: u32,
+}
+
+impl Present {
+    /// Of the cluster's fragments at `depth`, the earliest drawn passes alone exactly when it is
+    /// drawn before every nearer one of its cluster; the others at that depth fail the LESS test.
+    fn close(&mut self, passing: &mut Vec<(u32, u32)>) {
+        if self.at < self.before {
+            passing.push((self.cluster, self.depth));
         }
-        for p in 0..pixels {
-            self.pixel_start[p + 1] += self.pixel_start[p];
-        }
-        self.by_pixel.clear();
-        self.by_pixel.resize(self.fragments.len(), (0, 0.0));
-        self.cursor.clone_from(&self.pixel_start);
-        for f in &self.fragments {
-            let slot = &mut self.cursor[f.pixel as usize];
-            self.by_pixel[*slot as usize] = (cluster_of[f.triangle as usize], f.depth);
-            *slot += 1;
-        }
-        for p in 0..pixels {
-            let bucket = &self.by_pixel[self.pixel_start[p] as usize..self.pixel_start[p + 1] as usize];
-            if bucket.len() < 2 || bucket.iter().all(|&(c, _)| c == bucket[0].0) {
-                continue;
-            }
-            self.groups.clear();
-            self.passing.clear();
-            for &(c, z) in bucket {
-                match self.groups.last_mut() {
-                    Some(g) if g.0 == c => {
-                        if z < g.1 {
-                            g.1 = z;
-                            self.passing.push(z);
-                            g.3 += 1;
-                        }
-                    }
-                    _ => {
-                        self.groups.push((c, z, self.passing.len(), self.passing.len() + 1));
-                        self.passing.push(z);
-                    }
+        self.before = self.before.min(self.at);
+    }
+}
+
+impl PixelScratch {
+    /// Adds the pixel's `saved(a → b)`: b's alone-passing fragments at or behind a's nearest.
+    fn accumulate(&mut self, pixel: Contested, rank: &[u32], cluster_of: &[u32], graph: &mut OverdrawGraph) {
+        self.clusters.clear();
+        self.passing.clear();
+        for (t, depth) in pixel.by_depth() {
+            let (cluster, r) = (cluster_of[t as usize], rank[t as usize]);
+            match self.clusters.iter_mut().find(|p| p.cluster == cluster) {
+                Some(present) if present.depth == depth => present.at = present.at.min(r),
+                Some(present) => {
+                    present.close(&mut self.passing);
+                    (present.at, present.depth) = (r, depth);
                 }
+                None => self.clusters.push(Present { cluster, nearest: depth, before: u32::MAX, at: r, depth }),
             }
-            for &(a, nearest, _, _) in &self.groups {
-                for &(b, _, from, to) in &self.groups {
-                    if a != b {
-                        // b's alone-passing depths decrease; those at or behind a's nearest fail.
-                        let blocked = self.passing[from..to].iter().take_while(|&&z| z >= nearest).count();
-                        graph.saved[a as usize * graph.n + b as usize] += blocked as u64;
-                    }
+        }
+        if self.clusters.len() < 2 {
+            return;
+        }
+        for present in &mut self.clusters {
+            present.close(&mut self.passing);
+        }
+        for a in &self.clusters {
+            let row = &mut graph.saved[a.cluster as usize * graph.n..][..graph.n];
+            for &(b, depth) in &self.passing {
+                if b != a.cluster && depth >= a.nearest {
+                    row[b as usize] += 1;
                 }
             }
         }
