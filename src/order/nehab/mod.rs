@@ -5,8 +5,10 @@
 //! 2. each cluster ordered for the vertex cache by the inner locality ordering (`hoppe`, as the
 //!    paper, or `tipsify`), on its own;
 //! 3. the pairwise cluster overdraw graph over `views` icosahedral orthographic views at
-//!    `res`×`res`, computed exactly in one raster pass per view ([`overdraw_graph`], §4),
+//!    `res`×`res`, computed exactly from one rasterization per view ([`overdraw_graph`], §4),
 //!    with each cluster drawn in its inner order, so the graph measures what will be rendered;
+//!    the views are rasterized once per scene and kept for every nehab ordering of it with the
+//!    same views and resolution;
 //! 4. clusters ordered by the greedy minimum feedback arc set ([`feedback_arc_set`], §5)
 //!    and concatenated.
 //!
@@ -24,9 +26,10 @@ pub mod overdraw_graph;
 pub(crate) mod planar_clusters;
 
 use feedback_arc_set::greedy_order;
-use overdraw_graph::{ClusteredDraw, from_layers, one_pass};
+use overdraw_graph::from_layers;
 use planar_clusters::planar_clusters;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 use super::hoppe;
 use super::{Clustered, Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
@@ -122,16 +125,12 @@ struct Nehab {
 
 impl Ordering for Nehab {
     fn order(&self, scene: &Scene) -> Result<Orders> {
+        let (layers, reused) = self.views(scene)?;
         if !self.doubling {
-            return self.order_with(scene, self.clusters, None).map(Orders::from);
+            let mut orders = Orders::from(self.order_with(scene, self.clusters, &layers)?);
+            orders.reused = reused;
+            return Ok(orders);
         }
-        let mesh = &scene.mesh;
-        let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
-        // Every count's order draws the same triangles from the same views: each view is
-        // rasterized once, and each order's graph and depth test taken from it (what drawing the
-        // order would give).
-        let layers =
-            depth_layers(&mesh.positions, &mesh.triangles, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?;
         let mean_ovr = |order: &Clustered| -> Result<f64> {
             let rank = ranks(&order.order);
             let counts: Vec<ViewCounts> = layers.par_iter().map(|view| view.counts(&rank)).collect();
@@ -141,7 +140,7 @@ impl Ordering for Nehab {
         let mut tried: Vec<(Clustered, f64)> = Vec::new();
         let mut k = 1;
         loop {
-            let order = self.order_with(scene, k, Some(&layers))?;
+            let order = self.order_with(scene, k, &layers)?;
             let ovr = mean_ovr(&order)?;
             tried.push((order, ovr));
             let n = tried.len();
@@ -158,6 +157,7 @@ impl Ordering for Nehab {
                 let pick = knee().unwrap_or(n - 1);
                 let mut orders = Orders::from(tried.swap_remove(pick).0);
                 orders.iterations = Some(n);
+                orders.reused = reused;
                 return Ok(orders);
             }
             k = (2 * k).min(self.clusters);
@@ -166,9 +166,23 @@ impl Ordering for Nehab {
 }
 
 impl Nehab {
-    /// The order with `target` planar clusters; its graph from `layers` where the views of the
-    /// mesh have been rasterized already (their [`DepthLayers`]), else from rasterizing them.
-    fn order_with(&self, scene: &Scene, target: usize, layers: Option<&[DepthLayers]>) -> Result<Clustered> {
+    /// The rest mesh from the graph's views, rasterized once per scene and kept as
+    /// [`DepthLayers`]: every order of its triangles, whatever the cluster count, has its graph
+    /// and its depth test counted from them, so the nehab orderings of a scene that share views
+    /// and resolution (a sweep over cluster counts, the doubling search) rasterize them once.
+    /// Also the seconds reusing them saved, as they cost then.
+    fn views(&self, scene: &Scene) -> Result<(Arc<Vec<DepthLayers>>, f64)> {
+        let mesh = &scene.mesh;
+        let key = format!("the rest mesh's depth layers: ico:{} orthographic at {}²", self.views, self.res);
+        let (layers, reused) = scene.shared.get_or_compute(&key, || {
+            let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
+            depth_layers(&mesh.positions, &mesh.triangles, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))
+        })?;
+        Ok((layers, reused.unwrap_or(0.0)))
+    }
+
+    /// The order with `target` planar clusters, its graph counted from `layers` ([`Nehab::views`]).
+    fn order_with(&self, scene: &Scene, target: usize, layers: &[DepthLayers]) -> Result<Clustered> {
         let mesh = &scene.mesh;
         let clusters = planar_clusters(mesh, &scene.topology, target, self.seed);
         let members = members(&clusters.cluster, clusters.count);
@@ -176,15 +190,7 @@ impl Nehab {
         let inner_orders: Vec<Order> =
             members.par_iter().map(|tris| order_inside(mesh, tris, inner.ordering.as_ref())).collect::<Result<_>>()?;
         let local = Clustered::concat(inner_orders.iter().map(Vec::as_slice));
-        let graph = match layers {
-            Some(layers) => from_layers(layers, &ranks(&local.order), &clusters.cluster, clusters.count),
-            None => {
-                let triangles = mesh.triangles_in_order(&local.order);
-                let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &local.starts };
-                let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
-                one_pass(draw, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?
-            }
-        };
+        let graph = from_layers(layers, &ranks(&local.order), &clusters.cluster, clusters.count);
         let sequence = greedy_order(clusters.count, &graph.arcs());
         Ok(Clustered::concat(sequence.iter().map(|&c| inner_orders[c as usize].as_slice())))
     }
