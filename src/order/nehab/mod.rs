@@ -137,30 +137,41 @@ impl Ordering for Nehab {
             Ok(OverdrawSummary::of(&counts).map_or(1.0, |s| s.mean))
         };
         // Counts 1, 2, 4, … up to `clusters`, each ordered and measured once.
+        let measured = |k: usize| -> Result<(Clustered, f64)> {
+            let order = self.order_with(scene, k, &layers)?;
+            let ovr = mean_ovr(&order)?;
+            Ok((order, ovr))
+        };
         let mut tried: Vec<(Clustered, f64)> = Vec::new();
         let mut k = 1;
         loop {
-            let order = self.order_with(scene, k, &layers)?;
-            let ovr = mean_ovr(&order)?;
-            tried.push((order, ovr));
-            let n = tried.len();
-            let stalled = |a: usize| tried[a].1 - tried[a + 1].1 < STALL;
-            // The first count whose next two doublings both stall, once the overdraw has started
-            // improving: the first doublings of a mesh of several components change nothing (a
-            // cluster per component), and stopping there would never try the knee.
-            let knee = || {
-                let improved = (0..n.saturating_sub(1)).find(|&i| !stalled(i))?;
-                (improved + 1..n.saturating_sub(2)).find(|&i| stalled(i) && stalled(i + 1))
-            };
-            if knee().is_some() || k >= self.clusters {
-                // Else (the cap reached first) the last count tried.
-                let pick = knee().unwrap_or(n - 1);
-                let mut orders = Orders::from(tried.swap_remove(pick).0);
-                orders.iterations = Some(n);
-                orders.reused = reused;
-                return Ok(orders);
+            // Planar clustering runs on one thread: two counts are ordered side by side, and the
+            // second is dropped when the first settles the search (the same counts are tried
+            // and the same one picked as one at a time).
+            let next = (2 * k).min(self.clusters);
+            let (first, second) = rayon::join(|| measured(k), || (next > k).then(|| measured(next)));
+            for (count, result) in [(k, Some(first)), (next, second)] {
+                let Some(result) = result else { continue };
+                tried.push(result?);
+                let n = tried.len();
+                let stalled = |a: usize| tried[a].1 - tried[a + 1].1 < STALL;
+                // The first count whose next two doublings both stall, once the overdraw has
+                // started improving: the first doublings of a mesh of several components change
+                // nothing (a cluster per component), and stopping there would never try the knee.
+                let knee = || {
+                    let improved = (0..n.saturating_sub(1)).find(|&i| !stalled(i))?;
+                    (improved + 1..n.saturating_sub(2)).find(|&i| stalled(i) && stalled(i + 1))
+                };
+                if knee().is_some() || count >= self.clusters {
+                    // Else (the cap reached first) the last count tried.
+                    let pick = knee().unwrap_or(n - 1);
+                    let mut orders = Orders::from(tried.swap_remove(pick).0);
+                    orders.iterations = Some(n);
+                    orders.reused = reused;
+                    return Ok(orders);
+                }
             }
-            k = (2 * k).min(self.clusters);
+            k = (2 * next).min(self.clusters);
         }
     }
 }
