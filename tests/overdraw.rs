@@ -180,17 +180,20 @@ fn counting_many_orders_at_once_is_drawing_each() {
         triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
     }
     let n = triangles.len() as u32;
-    let orders: Vec<Vec<u32>> = vec![
+    let mut orders: Vec<Vec<u32>> = vec![
         (0..n).collect(),
         (0..n).rev().collect(),
         (0..n).map(|i| (u64::from(i) * 7919 % u64::from(n)) as u32).collect(),
     ];
+    // Rotations of the scrambled order: ten orders in all, more than are replayed side by side.
+    let scrambled = orders[2].clone();
+    orders.extend((1..8).map(|s| scrambled.iter().cycle().skip(s * 37).take(n as usize).copied().collect()));
     let slices: Vec<&[u32]> = orders.iter().map(|o| &o[..]).collect();
     let cameras = "ico:42".parse::<ViewSet>().unwrap().cameras(Framing::of(&positions), 0);
-    // Each view its own orders; then every view the same ten (the backend may replay orders
-    // that every view draws side by side, eight at a time).
-    let own: Vec<Vec<usize>> = (0..cameras.len()).map(|v| vec![v % 3, 2, (v + 1) % 3, 2]).collect();
-    let same = vec![vec![0, 1, 2, 2, 1, 0, 2, 1, 0, 1]; cameras.len()];
+    // Each view its own orders, one of them drawn by all; then every view the same ten, one
+    // twice (the backend may replay orders that every view draws side by side, eight at a time).
+    let own: Vec<Vec<usize>> = (0..cameras.len()).map(|v| vec![v % 3, 2, (v + 1) % 3, 2, 3 + v % 7]).collect();
+    let same = vec![vec![9, 0, 1, 2, 3, 4, 5, 6, 7, 8, 2]; cameras.len()];
     for (backend, picks) in common::backends().into_iter().flat_map(|b| [(b, &own), (b, &same)]) {
         let draws = OrderPicks { triangles: &triangles, orders: &slices, picks };
         let together = backend.count_orders(&positions, &cameras, &draws, 128).unwrap();

@@ -77,18 +77,28 @@ impl RasterBackend for CpuRaster {
         if orders.iter().any(|o| o.len() != triangles.len()) {
             return super::count_each_order(self, positions, cameras, draws, res);
         }
-        // Where every view draws the same orders (every order of a static method), they are
-        // replayed side by side ([`LaneRanks`]); else each view's picks one by one.
-        if let Some(same) = picks.first().filter(|first| picks.iter().all(|p| p == *first)) {
-            let ranks = LaneRanks::new(&same.iter().map(|&o| orders[o]).collect::<Vec<_>>());
-            return each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, _| {
-                scratch.layers(screen, triangles, res).counts_all(&ranks)
-            });
-        }
-        let ranks: Vec<Vec<u32>> = orders.par_iter().map(|o| layers::ranks(o)).collect();
+        // The orders every view draws (every static method's) are replayed side by side
+        // ([`LaneRanks`]); the others (view-dependent methods' buffers) one by one.
+        let mut everywhere: Vec<usize> = picks.first().cloned().unwrap_or_default();
+        everywhere.sort_unstable();
+        everywhere.dedup();
+        everywhere.retain(|o| picks.iter().all(|p| p.contains(o)));
+        let lanes = LaneRanks::new(&everywhere.iter().map(|&o| orders[o]).collect::<Vec<_>>());
+        // Ranks one by one for the others only (empty for those replayed side by side).
+        let ranks: Vec<Vec<u32>> = (0..orders.len())
+            .into_par_iter()
+            .map(|o| if everywhere.binary_search(&o).is_ok() { Vec::new() } else { layers::ranks(orders[o]) })
+            .collect();
         each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, v| {
             let layers = scratch.layers(screen, triangles, res);
-            picks[v].iter().map(|&o| layers.counts(&ranks[o])).collect()
+            let side_by_side = layers.counts_all(&lanes);
+            picks[v]
+                .iter()
+                .map(|&o| match everywhere.binary_search(&o) {
+                    Ok(lane) => side_by_side[lane],
+                    Err(_) => layers.counts(&ranks[o]),
+                })
+                .collect()
         })
     }
 }
