@@ -160,6 +160,7 @@ impl Ordering for Hs17 {
             triangles: &scene.mesh.triangles,
             keyframes,
             patches: &patches,
+            spans: Span::of(&patches),
             cameras: &cameras,
         };
         let groups: Vec<Range<usize>> = if self.joint {
@@ -204,7 +205,29 @@ struct Nodes<'a> {
     triangles: &'a [[u32; 3]],
     keyframes: &'a Frames,
     patches: &'a Clustered,
+    /// Each patch's place in `patches`, packed for [`Nodes::buffer`].
+    spans: Vec<Span>,
     cameras: &'a [Camera],
+}
+
+/// Where a patch lies in the patch order, with its first triangle: one memory access per patch
+/// when a buffer is assembled in a sequence that visits them at random (at λ 3 most patches are
+/// one triangle, and looking up the bounds and then the triangle took two cache misses each).
+#[derive(Clone, Copy)]
+struct Span {
+    first: u32,
+    start: u32,
+    len: u32,
+}
+
+impl Span {
+    fn of(patches: &Clustered) -> Vec<Span> {
+        patches
+            .starts
+            .windows(2)
+            .map(|w| Span { first: patches.order[w[0]], start: w[0] as u32, len: (w[1] - w[0]) as u32 })
+            .collect()
+    }
 }
 
 impl Nodes<'_> {
@@ -213,9 +236,44 @@ impl Nodes<'_> {
     }
 
     /// The buffer drawing the patches in `sequence`, each patch a cluster.
-    fn buffer(&self, sequence: &[usize]) -> Clustered {
-        let starts = &self.patches.starts;
-        Clustered::concat(sequence.iter().map(|&p| &self.patches.order[starts[p]..starts[p + 1]]))
+    fn buffer(&self, sequence: &[u32]) -> Clustered {
+        let mut order = Vec::with_capacity(self.patches.order.len());
+        let mut starts = Vec::with_capacity(sequence.len() + 1);
+        starts.push(0);
+        for &p in sequence {
+            match self.spans[p as usize] {
+                Span { first, len: 1, .. } => order.push(first),
+                Span { start, len, .. } => {
+                    order.extend_from_slice(&self.patches.order[start as usize..(start + len) as usize])
+                }
+            }
+            starts.push(order.len());
+        }
+        Clustered { order, starts }
+    }
+
+    /// The patches by increasing `keys` (one per patch), and the buffer drawing them so.
+    ///
+    /// Each patch's one triangle, if it has one only, travels with it through the sort (for free:
+    /// an entry is 16 bytes either way), so that at λ 3, where nearly every patch is one
+    /// triangle, the buffer is written without looking the patches up in random order.
+    fn sorted(&self, keys: impl Iterator<Item = f64>) -> (Vec<u32>, Clustered) {
+        let alone = |s: &Span| if s.len == 1 { s.first } else { u32::MAX };
+        let sorted = sort_by_key(keys.zip(self.spans.iter().map(alone)));
+        let mut order = Vec::with_capacity(self.patches.order.len());
+        let mut starts = Vec::with_capacity(sorted.len() + 1);
+        starts.push(0);
+        for &(p, alone) in &sorted {
+            match alone {
+                u32::MAX => {
+                    let Span { start, len, .. } = self.spans[p as usize];
+                    order.extend_from_slice(&self.patches.order[start as usize..(start + len) as usize]);
+                }
+                t => order.push(t),
+            }
+            starts.push(order.len());
+        }
+        (sorted.into_iter().map(|(p, _)| p).collect(), Clustered { order, starts })
     }
 }
 
@@ -242,28 +300,31 @@ impl Hs17 {
         let frame_count = frames.len();
         let average: Vec<Vec3> =
             centroids.chunks(frame_count).map(|c| c.iter().sum::<Vec3>() / c.len() as f32).collect();
+        let centroids = Centroids::of(&centroids, frame_count);
         clock.lap("centroids");
 
-        let mut buffers: Vec<Clustered> = self
+        // Each buffer's patch sequence, and the buffer it draws.
+        let (mut sequences, mut buffers): (Vec<Vec<u32>>, Vec<Clustered>) = self
             .initial_viewpoints(views, scene.cameras)
             .iter()
-            .map(|&v| scene.buffer(&sort_by_key(&average, |c| c.distance(scene.cameras[v].unit_eye()))))
-            .collect();
+            .map(|&v| scene.sorted(average.iter().map(|c| f64::from(c.distance(scene.cameras[v].unit_eye())))))
+            .unzip();
         let (frame_nodes, reused) = rasterize_nodes(scene, frames.clone(), self.res)?;
         let nodes: Vec<&DepthLayers> = frame_nodes.iter().flat_map(|f| f.iter()).collect();
         clock.lap("rasterization");
         clock.charge("rasterization", reused);
         let mut assignment: Vec<u16> = vec![u16::MAX; nodes.len()];
-        // Step 2's integrated distance d(p) of every patch for every cluster (patch-major:
-        // `integrated[p × k + c]`), summed over the nodes `counted` in that cluster.
+        // Step 2's integrated distance d(p) of every patch for every cluster, a column per
+        // cluster (`integrated[c × patches + p]`), summed over the nodes `counted` in that cluster.
         let k = buffers.len();
-        let mut integrated = vec![0.0f64; scene.patch_count() * k];
+        let patch_count = scene.patch_count();
+        let mut integrated = vec![0.0f64; patch_count * k];
         let mut counted: Vec<u16> = vec![u16::MAX; nodes.len()];
         let mut iteration = 0;
-        // The round with the fewest passing fragments so far: its fragments, buffers and
-        // assignment (a buffer set and the assignment made from it, so the lookup stays true to
-        // the buffers); and the rounds since it.
-        let mut best: Option<(u64, Vec<Clustered>, Vec<u16>)> = None;
+        // The round with the fewest passing fragments so far: its fragments, buffers (as patch
+        // sequences, a fraction of their size) and assignment (a buffer set and the assignment
+        // made from it, so the lookup stays true to the buffers); and the rounds since it.
+        let mut best: Option<(u64, Vec<Vec<u32>>, Vec<u16>)> = None;
         let mut stalled = 0;
         loop {
             iteration += 1;
@@ -272,14 +333,15 @@ impl Hs17 {
             let settled = next == assignment;
             assignment = next;
             if best.as_ref().is_none_or(|b| passed < b.0) {
-                best = Some((passed, buffers.clone(), assignment.clone()));
+                best = Some((passed, sequences.clone(), assignment.clone()));
                 stalled = 0;
             } else {
                 stalled += 1;
             }
             let converged = settled || stalled == STALL_ROUNDS;
             if converged || iteration == self.max_iterations {
-                let (_, buffers, assignment) = best.expect("one round has run");
+                let (_, sequences, assignment) = best.expect("one round has run");
+                let buffers = sequences.iter().map(|s| scene.buffer(s)).collect();
                 return Ok(KMeans { buffers, assignment, iterations: iteration, converged, reused });
             }
             // Step 2 for the clusters whose nodes changed: the integrated distances follow the
@@ -288,16 +350,16 @@ impl Hs17 {
             // distances (between 1 and 8 or so, from viewpoints at three radii) are exact, so
             // adding and taking away a node leaves the sum a recount would give.
             let moved: Vec<usize> = (0..nodes.len()).filter(|&n| counted[n] != assignment[n]).collect();
-            integrated.par_chunks_mut(k).enumerate().for_each(|(p, sums)| {
-                let at = &centroids[p * frame_count..(p + 1) * frame_count];
-                for &n in &moved {
-                    let d = f64::from(scene.cameras[n % views].unit_eye().distance(at[n / views]));
-                    if let Some(before) = sums.get_mut(usize::from(counted[n])) {
-                        *before -= d;
-                    }
-                    sums[usize::from(assignment[n])] += d;
-                }
-            });
+            let moves: Vec<Move> = moved
+                .iter()
+                .map(|&n| Move {
+                    eye: scene.cameras[n % views].unit_eye(),
+                    frame: n / views,
+                    from: usize::from(counted[n]),
+                    to: usize::from(assignment[n]),
+                })
+                .collect();
+            integrate(&mut integrated, k, &centroids, &moves);
             let mut changed = vec![false; k];
             for &n in &moved {
                 for c in [counted[n], assignment[n]] {
@@ -307,11 +369,11 @@ impl Hs17 {
                 }
                 counted[n] = assignment[n];
             }
-            for (c, buffer) in buffers.iter_mut().enumerate() {
+            for c in 0..k {
                 // A cluster left with no node keeps its buffer.
                 if changed[c] && assignment.contains(&(c as u16)) {
-                    let column: Vec<f64> = integrated.iter().skip(c).step_by(k).copied().collect();
-                    *buffer = scene.buffer(&sort_by_key(&column, |&d| d));
+                    (sequences[c], buffers[c]) =
+                        scene.sorted(integrated[c * patch_count..(c + 1) * patch_count].iter().copied());
                 }
             }
             clock.lap("buffers");
@@ -342,12 +404,16 @@ impl Hs17 {
     }
 }
 
-/// Indices `0..keys.len()` sorted by increasing `key`, ties by index.
-fn sort_by_key<T, K: Into<f64>>(keys: &[T], key: impl Fn(&T) -> K) -> Vec<usize> {
-    let values: Vec<f64> = keys.iter().map(|k| key(k).into()).collect();
-    let mut sorted: Vec<usize> = (0..keys.len()).collect();
-    sorted.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
-    sorted
+/// The indices of `keyed` (key, payload) pairs sorted by increasing key ([`f64::total_cmp`]'s
+/// order), ties by index, each with its payload.
+///
+/// A radix sort (`radsort`: stable, so ties stay in index order, and it skips the bytes every key
+/// shares): step 2 sorts every patch once per changed cluster per round, and at λ 3 a patch is a
+/// triangle (786k on Xbot subdivided twice), where a comparison sort took a third of the run.
+fn sort_by_key(keyed: impl Iterator<Item = (f64, u32)>) -> Vec<(u32, u32)> {
+    let mut entries: Vec<(f64, u32, u32)> = keyed.zip(0..).map(|((k, payload), i)| (k, i, payload)).collect();
+    radsort::sort_by_key(&mut entries, |e| e.0);
+    entries.into_iter().map(|(_, i, payload)| (i, payload)).collect()
 }
 
 /// Per patch, per frame of `frames`: the mean of its triangles' corners, in the unit frame the
@@ -395,6 +461,74 @@ fn rasterize_nodes(scene: &Nodes, frames: Range<usize>, res: u32) -> Result<(Vec
     Ok((nodes, reused))
 }
 
+/// The patch centroids of each frame, coordinate by coordinate (`x[f × patches + p]`), so that a
+/// node's distances to every patch are one loop the compiler vectorizes.
+struct Centroids {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    patches: usize,
+}
+
+impl Centroids {
+    /// From patch-major centroids (`centroids[p × frames + f]`).
+    fn of(centroids: &[Vec3], frames: usize) -> Centroids {
+        let patches = centroids.len() / frames.max(1);
+        let coordinate = |axis: usize| -> Vec<f32> {
+            (0..frames).flat_map(|f| (0..patches).map(move |p| centroids[p * frames + f][axis])).collect()
+        };
+        Centroids { x: coordinate(0), y: coordinate(1), z: coordinate(2), patches }
+    }
+}
+
+/// A node that changed cluster since the integrated distances were last summed: its viewpoint,
+/// its frame (counted from the run's first) and its clusters before (out of range when it had
+/// none) and now.
+struct Move {
+    eye: Vec3,
+    frame: usize,
+    from: usize,
+    to: usize,
+}
+
+/// Patches per parallel piece of [`integrate`]: a piece's columns and centroids stay in cache
+/// while every move is added.
+const PIECE: usize = 4096;
+
+/// Follows `moves` in the integrated distances (`k` columns of `centroids.patches`): each moved
+/// node's distance to every patch centroid at its frame taken from its old cluster's column and
+/// added to its new one's. Each distance is `(eye − centroid).length()` in f32 as glam computes
+/// it, so the sums are those a recount would give (module notes: in f64 they are exact).
+fn integrate(integrated: &mut [f64], k: usize, centroids: &Centroids, moves: &[Move]) {
+    let patches = centroids.patches;
+    if patches == 0 {
+        return;
+    }
+    let mut columns: Vec<_> = integrated.chunks_mut(patches).map(|c| c.chunks_mut(PIECE)).collect();
+    let pieces: Vec<Vec<&mut [f64]>> =
+        (0..patches.div_ceil(PIECE)).map(|_| columns.iter_mut().filter_map(Iterator::next).collect()).collect();
+    pieces.into_par_iter().enumerate().for_each_init(
+        || vec![0.0f64; PIECE],
+        |distances, (piece, mut columns)| {
+            debug_assert_eq!(columns.len(), k);
+            let start = piece * PIECE;
+            let len = columns[0].len();
+            for m in moves {
+                let at = m.frame * patches + start;
+                let (x, y, z) = (&centroids.x[at..at + len], &centroids.y[at..at + len], &centroids.z[at..at + len]);
+                for (((d, &x), &y), &z) in distances.iter_mut().zip(x).zip(y).zip(z) {
+                    let (dx, dy, dz) = (x - m.eye.x, y - m.eye.y, z - m.eye.z);
+                    *d = f64::from((dx * dx + dy * dy + dz * dz).sqrt());
+                }
+                if let Some(from) = columns.get_mut(m.from) {
+                    from.iter_mut().zip(&*distances).for_each(|(s, d)| *s -= d);
+                }
+                columns[m.to].iter_mut().zip(&*distances).for_each(|(s, d)| *s += d);
+            }
+        },
+    );
+}
+
 /// Step 1: each node to the buffer with the fewest passing fragments; a node keeps its
 /// `previous` buffer when that one ties for the fewest. Also returns those fewest fragments
 /// summed over the nodes: what the assignment minimizes.
@@ -439,5 +573,22 @@ impl Clock {
             Some((_, s)) => *s += seconds,
             None => self.phases.push((phase, seconds)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The integer keys order floats as `total_cmp` does, and the sort breaks ties by index.
+    #[test]
+    fn sorting_by_key_is_total_order_then_index() {
+        let keys = [3.5, -0.0, 0.0, -2.0, f64::INFINITY, 1e-300, -1e300, 3.5, f64::NAN, -f64::NAN, 0.0];
+        let mut expected: Vec<usize> = (0..keys.len()).collect();
+        expected.sort_by(|&a, &b| keys[a].total_cmp(&keys[b]).then(a.cmp(&b)));
+        let sorted = sort_by_key(keys.iter().map(|&k| (k, 0)).zip(100..).map(|((k, _), p)| (k, p)));
+        assert_eq!(sorted.iter().map(|&(i, _)| i as usize).collect::<Vec<_>>(), expected);
+        assert!(sorted.iter().all(|&(i, payload)| payload == 100 + i));
+        assert_eq!(&expected[..3], &[9, 6, 3]);
     }
 }

@@ -123,9 +123,16 @@ impl Clustered {
 
     /// The clusters drawn in the given sequence.
     pub fn concat<'a>(clusters: impl Iterator<Item = &'a [u32]>) -> Clustered {
-        let (mut order, mut starts) = (Vec::new(), vec![0]);
+        let mut starts = Vec::with_capacity(clusters.size_hint().0 + 1);
+        starts.push(0);
+        let mut order = Vec::new();
         for cluster in clusters {
-            order.extend_from_slice(cluster);
+            // A cluster of one triangle (every patch of Tipsify's at λ 3) is pushed: there a
+            // `memcpy` call per cluster cost several times the copy.
+            match cluster {
+                [t] => order.push(*t),
+                _ => order.extend_from_slice(cluster),
+            }
             starts.push(order.len());
         }
         Clustered { order, starts }
