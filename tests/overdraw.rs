@@ -11,7 +11,7 @@ use glam::{Mat4, Vec3};
 use triorder::measure::OverdrawSummary;
 use triorder::mesh::Framing;
 use triorder::mesh::{Mesh, VertexAttributes, procedural};
-use triorder::raster::{Camera, OrderPicks, ViewCounts, ViewSet};
+use triorder::raster::{Camera, OrderPicks, RasterBackend, ViewCounts, ViewSet};
 
 /// Identity camera: world = unit frame = NDC (x, y in -1..1 map to the image, z in 0..1 is depth).
 fn ndc_camera() -> Camera {
@@ -208,5 +208,28 @@ fn counting_many_orders_at_once_is_drawing_each() {
         }
         // The scene must exercise the replay: most draws shade some pixel twice.
         assert!(overdrawn > cameras.len(), "{}: only {overdrawn} draws with overdraw", backend.name());
+    }
+}
+
+/// A vertex the views cannot draw is named as the mesh numbers it, whether the views are drawn
+/// in the given order or from depth layers (which draw the triangles renumbered for locality):
+/// here the bad triangle comes first and its vertices are 0–2, but in space it lies last.
+#[test]
+fn a_bad_vertex_is_named_as_given_on_every_path() {
+    let mut positions: Vec<Vec3> = [[1e4, 0.0, 0.0], [1e4, 1.0, 0.0], [1e4, 0.0, 1.0]].map(Vec3::from).to_vec();
+    positions.extend([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]].map(Vec3::from));
+    let triangles = vec![[0, 1, 2], [3, 4, 5], [3, 5, 6]];
+    let cameras = "ico:12".parse::<ViewSet>().unwrap().cameras(Framing::of(&positions[3..]), 0);
+    let order: Vec<u32> = vec![0, 1, 2];
+    let picks = vec![vec![0]; cameras.len()];
+    let draws = OrderPicks { triangles: &triangles, orders: &[&order], picks: &picks };
+    let cpu = triorder::raster::cpu::CpuRaster;
+    let errors = [
+        cpu.count(&positions, &triangles, &cameras, 64).unwrap_err().to_string(),
+        cpu.count_orders(&positions, &cameras, &draws, 64).unwrap_err().to_string(),
+        triorder::raster::cpu::depth_layers(&positions, &triangles, &cameras, 64).unwrap_err().to_string(),
+    ];
+    for e in &errors {
+        assert!(e.contains("vertex 0 "), "{e}");
     }
 }

@@ -60,7 +60,9 @@ impl RasterBackend for CpuRaster {
         cameras: &[Camera],
         res: u32,
     ) -> Result<Vec<ViewCounts>> {
-        each_view(positions, cameras, res, Vec::new, |depth, screen, _| draw(screen, triangles, res, depth, |_| {}))
+        each_view(positions, cameras, res, Vec::new, |depth, screen, _| {
+            draw::<true>(screen, triangles, res, depth, |_| {})
+        })
     }
 
     /// Each view rasterized once, its fragments kept as [`DepthLayers`], and every order picked
@@ -89,8 +91,9 @@ impl RasterBackend for CpuRaster {
             .into_par_iter()
             .map(|o| if everywhere.binary_search(&o).is_ok() { Vec::new() } else { layers::ranks(orders[o]) })
             .collect();
-        each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, v| {
-            let layers = scratch.layers(screen, triangles, res);
+        let local = Local::of(positions, triangles);
+        let counted = each_view(&local.positions, cameras, res, LayerScratch::default, |scratch, screen, v| {
+            let layers = scratch.layers(screen, &local, res);
             let side_by_side = layers.counts_all(&lanes);
             picks[v]
                 .iter()
@@ -99,7 +102,8 @@ impl RasterBackend for CpuRaster {
                     Err(_) => layers.counts(&ranks[o]),
                 })
                 .collect()
-        })
+        });
+        named_as_given(counted, positions, cameras, res)
     }
 }
 
@@ -111,23 +115,102 @@ pub fn depth_layers(
     cameras: &[Camera],
     res: u32,
 ) -> Result<Vec<DepthLayers>> {
-    each_view(positions, cameras, res, LayerScratch::default, |scratch, screen, _| {
-        scratch.layers(screen, triangles, res)
+    let local = Local::of(positions, triangles);
+    let layers = each_view(&local.positions, cameras, res, LayerScratch::default, |scratch, screen, _| {
+        scratch.layers(screen, &local, res)
+    });
+    named_as_given(layers, positions, cameras, res)
+}
+
+/// `result` of views of renumbered vertices ([`Local`]), with a projection error named as the
+/// caller numbers the vertices: the first view's error on the vertices as given.
+fn named_as_given<T>(result: Result<T>, positions: &[Vec3], cameras: &[Camera], res: u32) -> Result<T> {
+    result.or_else(|e| {
+        each_view(positions, cameras, res, || (), |_, _, _| ())?;
+        Err(e)
     })
 }
 
-/// One thread's buffers for [`DepthLayers`]: the depth buffer, the fragments, the pixel slots.
+/// A mesh renumbered for locality, for what does not depend on the draw order (a view's
+/// [`DepthLayers`]: its fragments sorted by depth and triangle id): the triangles in Morton order
+/// of their centroids and the vertices by first use, so that consecutive triangles fetch their
+/// corners from nearby memory. In the order as given, a subdivided mesh's corners are spread
+/// over the whole vertex array (Loop subdivision appends the edge vertices), and fetching them
+/// was most of drawing a view of a dense mesh.
+struct Local {
+    /// The positions, by new vertex number; unused vertices last, so that every vertex is still
+    /// projected (and a bad one still fails a view).
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    /// Each triangle's index in the caller's list.
+    ids: Vec<u32>,
+}
+
+impl Local {
+    fn of(positions: &[Vec3], triangles: &[[u32; 3]]) -> Local {
+        let centroid = |t: &[u32; 3]| t.iter().map(|&v| positions[v as usize]).sum::<Vec3>() / 3.0;
+        let (lo, hi) = triangles
+            .iter()
+            .map(centroid)
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)));
+        let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let mut keyed: Vec<(u32, u32)> = triangles
+            .iter()
+            .zip(0..)
+            .map(|(t, i)| {
+                let q = ((centroid(t) - lo) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+                (spread(q.x as u32) | spread(q.y as u32) << 1 | spread(q.z as u32) << 2, i)
+            })
+            .collect();
+        radsort::sort_by_key(&mut keyed, |k| k.0);
+        let mut number = vec![u32::MAX; positions.len()];
+        let mut order: Vec<u32> = Vec::with_capacity(positions.len());
+        let triangles = keyed
+            .iter()
+            .map(|&(_, i)| {
+                triangles[i as usize].map(|v| {
+                    if number[v as usize] == u32::MAX {
+                        number[v as usize] = order.len() as u32;
+                        order.push(v);
+                    }
+                    number[v as usize]
+                })
+            })
+            .collect();
+        order.extend((0..positions.len() as u32).filter(|&v| number[v as usize] == u32::MAX));
+        Local {
+            positions: order.iter().map(|&v| positions[v as usize]).collect(),
+            triangles,
+            ids: keyed.into_iter().map(|(_, i)| i).collect(),
+        }
+    }
+}
+
+/// The low 10 bits of `x` spread to every third bit (a Morton code's one axis).
+fn spread(x: u32) -> u32 {
+    let mut x = x & 0x3ff;
+    x = (x | x << 16) & 0x030000ff;
+    x = (x | x << 8) & 0x0300f00f;
+    x = (x | x << 4) & 0x030c30c3;
+    (x | x << 2) & 0x09249249
+}
+
+/// One thread's buffers for [`DepthLayers`]: the fragments and the pixel slots.
 #[derive(Default)]
 struct LayerScratch {
-    depth: Vec<f32>,
     fragments: Vec<Fragment>,
     slots: Vec<u32>,
 }
 
 impl LayerScratch {
-    fn layers(&mut self, screen: &[ScreenVertex], triangles: &[[u32; 3]], res: u32) -> DepthLayers {
+    /// The view's layers of `local`'s triangles, ids as the caller numbers them. Drawn without a
+    /// depth test: the layers keep every fragment, and which passed in this order is not used.
+    fn layers(&mut self, screen: &[ScreenVertex], local: &Local, res: u32) -> DepthLayers {
         self.fragments.clear();
-        draw(screen, triangles, res, &mut self.depth, |f| self.fragments.push(f));
+        let ids = &local.ids;
+        draw::<false>(screen, &local.triangles, res, &mut Vec::new(), |f| {
+            self.fragments.push(Fragment { triangle: ids[f.triangle as usize], ..f })
+        });
         DepthLayers::of(&self.fragments, res, &mut self.slots)
     }
 }
@@ -174,7 +257,7 @@ pub fn visible_triangles(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Ca
     let mut screen = Vec::new();
     project(&camera.framing.unit_positions(positions), camera, res, &mut screen).map_err(Error::usage)?;
     let mut seen = vec![u32::MAX; res as usize * res as usize];
-    draw(&screen, triangles, res, &mut Vec::new(), |f| {
+    draw::<true>(&screen, triangles, res, &mut Vec::new(), |f| {
         if f.passed {
             seen[f.pixel as usize] = f.triangle
         }
@@ -190,7 +273,7 @@ pub fn shaded_per_pixel(positions: &[Vec3], triangles: &[[u32; 3]], camera: &Cam
     let mut screen = Vec::new();
     project(&camera.framing.unit_positions(positions), camera, res, &mut screen).map_err(Error::usage)?;
     let mut shaded = vec![0u32; res as usize * res as usize];
-    draw(&screen, triangles, res, &mut Vec::new(), |f| {
+    draw::<true>(&screen, triangles, res, &mut Vec::new(), |f| {
         if f.passed {
             shaded[f.pixel as usize] += 1
         }
@@ -223,7 +306,7 @@ pub fn fragments(
     let mut screen = Vec::new();
     project(&camera.framing.unit_positions(positions), camera, res, &mut screen).map_err(Error::usage)?;
     out.clear();
-    draw(&screen, triangles, res, &mut Vec::new(), |f| out.push(f));
+    draw::<true>(&screen, triangles, res, &mut Vec::new(), |f| out.push(f));
     Ok(())
 }
 
@@ -332,8 +415,9 @@ impl Edge {
 }
 
 /// Draws `triangles` in order into a cleared depth buffer and counts; `on_fragment` sees every
-/// front-facing fragment, passed or not (a no-op closure compiles away).
-fn draw(
+/// front-facing fragment, passed or not (a no-op closure compiles away). Without `DEPTH_TEST`
+/// there is no depth buffer: every fragment is reported as not passed, and nothing is counted.
+fn draw<const DEPTH_TEST: bool>(
     v: &[ScreenVertex],
     triangles: &[[u32; 3]],
     res: u32,
@@ -341,8 +425,10 @@ fn draw(
     mut on_fragment: impl FnMut(Fragment),
 ) -> ViewCounts {
     let n = res as usize;
-    depth.clear();
-    depth.resize(n * n, 1.0);
+    if DEPTH_TEST {
+        depth.clear();
+        depth.resize(n * n, 1.0);
+    }
     let mut counts = ViewCounts::default();
     let last = i64::from(res) - 1;
     for (t, tri) in triangles.iter().enumerate() {
@@ -384,12 +470,15 @@ fn draw(
             let zy = a.z + dzdy * (y as f32 + 0.5 - ay);
             let mut fragment = |x: i64| {
                 let z = zy + dzdx * (x as f32 + 0.5 - ax);
-                let d = &mut depth[row + x as usize];
-                let passed = z < *d;
-                if passed {
-                    counts.covered += u64::from(*d == 1.0);
-                    *d = z;
-                    counts.passed += 1;
+                let mut passed = false;
+                if DEPTH_TEST {
+                    let d = &mut depth[row + x as usize];
+                    passed = z < *d;
+                    if passed {
+                        counts.covered += u64::from(*d == 1.0);
+                        *d = z;
+                        counts.passed += 1;
+                    }
                 }
                 on_fragment(Fragment { pixel: (row + x as usize) as u32, triangle: t as u32, depth: z, passed });
             };
