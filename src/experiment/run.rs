@@ -8,6 +8,7 @@
 //! their wall times are honest; only the rasterizer runs in parallel, inside one measurement. The
 //! CSV is written atomically at the end: an interrupted run leaves the previous results untouched.
 
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
@@ -84,7 +85,58 @@ pub struct Failure {
 /// Runs the spec at `spec` and writes its CSV (or the shard's file).
 pub fn run(spec: &Path, opts: &RunOptions) -> Result<Outcome> {
     let spec = Spec::load(spec)?;
-    run_spec(&spec, opts, &bars(opts.progress))
+    run_spec(&spec, opts, &bars(opts.progress), &mut OrderMemo::default())
+}
+
+/// Orders that one spec of a run computes and a later spec asks for again: the same model opened
+/// the same way (source, seed, levels, update), the same method with the same parameters, under
+/// the same draw-call rule, which make the same orders. `reproduce` runs every spec with one, so a
+/// model's orders are computed once however many specs measure them (several order "all"
+/// methods on the same shared models). A reused order keeps the seconds it took when it was
+/// computed, its own time, as [`crate::mesh::scene::SharedWork`] charges a reuse. Only orders a
+/// later spec asks for are kept, each until the last spec that asks for it has run.
+#[derive(Default)]
+pub struct OrderMemo {
+    /// Per key, the specs still to run that ask for it.
+    wanted: HashMap<String, HashSet<String>>,
+    kept: HashMap<String, Evaluation>,
+}
+
+impl OrderMemo {
+    /// A memo for running `specs` in turn under `opts`.
+    pub fn for_specs<'s>(specs: impl IntoIterator<Item = &'s Spec>, opts: &RunOptions) -> Result<OrderMemo> {
+        let mut wanted: HashMap<String, HashSet<String>> = HashMap::new();
+        for spec in specs {
+            let plan = Plan::new(spec, opts)?;
+            for u in 0..plan.units.len() {
+                wanted.entry(plan.key(spec, opts, u)?).or_default().insert(spec.id.clone());
+            }
+        }
+        wanted.retain(|_, specs| specs.len() > 1);
+        Ok(OrderMemo { wanted, kept: HashMap::new() })
+    }
+
+    /// The evaluation for `key` asked for by `spec`: the one kept, or what `order` gives, kept
+    /// when a later spec asks for it too.
+    fn order(&mut self, spec: &str, key: String, order: impl FnOnce() -> Result<Evaluation>) -> Result<Evaluation> {
+        if let Some(kept) = self.kept.get(&key) {
+            return Ok(kept.clone());
+        }
+        let evaluation = order()?;
+        if self.wanted.get(&key).is_some_and(|specs| specs.iter().any(|s| s != spec)) {
+            self.kept.insert(key, evaluation.clone());
+        }
+        Ok(evaluation)
+    }
+
+    /// Forgets `spec`'s claims once it has run, dropping the orders no spec still to run asks for.
+    fn finished(&mut self, spec: &str) {
+        self.wanted.retain(|_, specs| {
+            specs.remove(spec);
+            !specs.is_empty()
+        });
+        self.kept.retain(|key, _| self.wanted.contains_key(key));
+    }
 }
 
 /// What a run of a spec works through: its models (corpora expanded), methods and updates, the
@@ -111,6 +163,21 @@ impl<'a> Plan<'a> {
         let names: Vec<String> = models.iter().map(|m| m.name.clone()).collect();
         let fingerprint = shard::fingerprint(&spec.text, opts.quick, opts.backend.as_deref(), &names);
         Ok(Plan { models, methods, updates, units, fingerprint })
+    }
+
+    /// What makes unit `u`'s order ([`OrderMemo`]): how its scene is opened and its method.
+    fn key(&self, spec: &Spec, opts: &RunOptions, u: usize) -> Result<String> {
+        let work = spec.workload(opts.quick)?;
+        let unit = &self.units[u];
+        Ok(format!(
+            "{:?} seed {} levels {:?} update {:?} per draw call {} · {}",
+            self.models[unit.model].source,
+            spec.seed,
+            work.levels,
+            self.updates[unit.update],
+            spec.measure_options(work).per_draw_call,
+            self.methods[unit.method].canonical()
+        ))
     }
 
     /// The units `shard` does: those [`shard::assign`] gives it by estimated cost.
@@ -140,7 +207,7 @@ fn recorded(e: &Error) -> bool {
 }
 
 /// Runs a loaded spec, showing its progress bar among `bars`.
-pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<Outcome> {
+pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut OrderMemo) -> Result<Outcome> {
     let work = spec.workload(opts.quick)?;
     let data = source::data_dir(opts.data.as_deref());
     let plan = Plan::new(spec, opts)?;
@@ -225,7 +292,8 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
             for &u in batch {
                 let method = &plan.methods[plan.units[u].method];
                 bar.set_message(format!("{} · {}", model.name, method.canonical()));
-                match measure::order_timed(&scene, method, &options) {
+                let key = plan.key(spec, opts, u)?;
+                match memo.order(&spec.id, key, || measure::order_timed(&scene, method, &options)) {
                     Ok(evaluation) => ordered.push((u, evaluation)),
                     Err(e) => {
                         failed_unit(e, model, method, &context, (u, &mut rows), &mut failures)?;
@@ -272,6 +340,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress) -> Result<
     }
     bar.finish_and_clear();
     bars.remove(&bar);
+    memo.finished(&spec.id);
     // In unit order (a batch's ordering failures were recorded before its measured rows).
     rows.sort_by_key(|(u, _)| *u);
     orders_rows.sort_by_key(|(u, _)| *u);
@@ -436,4 +505,45 @@ pub fn bars(progress: bool) -> MultiProgress {
 
 pub fn style(template: &str) -> ProgressStyle {
     ProgressStyle::with_template(template).expect("progress templates are valid")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn evaluation(seconds: f64) -> Evaluation {
+        Evaluation {
+            method: "input".into(),
+            method_name: "input",
+            peer: false,
+            seconds,
+            orders: Orders::from(vec![0u32, 1]),
+            measured: Vec::new(),
+        }
+    }
+
+    /// An order is kept for the later specs that ask for it, with its first seconds, and for
+    /// nothing else; once they have run it is gone.
+    #[test]
+    fn a_memo_keeps_an_order_only_for_the_later_specs_that_ask_for_it() {
+        let claims = HashSet::from(["a".to_string(), "b".to_string()]);
+        let mut memo = OrderMemo { wanted: HashMap::from([("k".to_string(), claims)]), kept: HashMap::new() };
+        let mut computed = 0;
+        let mut order = |memo: &mut OrderMemo, spec: &str, key: &str, seconds: f64| {
+            memo.order(spec, key.to_string(), || {
+                computed += 1;
+                Ok(evaluation(seconds))
+            })
+            .unwrap()
+            .seconds
+        };
+        assert_eq!(order(&mut memo, "a", "k", 1.0), 1.0);
+        assert_eq!(order(&mut memo, "a", "alone", 2.0), 2.0);
+        assert_eq!(memo.kept.len(), 1);
+        memo.finished("a");
+        assert_eq!(order(&mut memo, "b", "k", 3.0), 1.0);
+        memo.finished("b");
+        assert!(memo.kept.is_empty() && memo.wanted.is_empty());
+        assert_eq!(computed, 2);
+    }
 }
