@@ -393,7 +393,8 @@ const SPAN_FROM: i64 = 4;
 impl Edge {
     /// The pixel steps `k` from the row's start where `row + k·step_x ≥ 0`, as an inclusive
     /// range (empty when the first exceeds the second): exactly the pixels the per-pixel test
-    /// passes.
+    /// passes. The definition, dividing on each row, that [`EdgeRows`] is checked against.
+    #[cfg(test)]
     fn inside(&self) -> (i64, i64) {
         match self.step_x {
             // k ≥ ⌈−row / step⌉
@@ -405,12 +406,60 @@ impl Edge {
         }
     }
 
+    /// [`Edge::inside`] of this row and every row below it in turn ([`EdgeRows`]).
+    fn rows(&self) -> EdgeRows {
+        // A horizontal edge (no step in x) tests `row ≥ 0`, which is `⌊row / 1⌋ ≥ 0`.
+        let divisor = self.step_x.abs().max(1);
+        EdgeRows {
+            quotient: self.row.div_euclid(divisor),
+            remainder: self.row.rem_euclid(divisor),
+            step_quotient: self.step_y.div_euclid(divisor),
+            step_remainder: self.step_y.rem_euclid(divisor),
+            divisor,
+            sign: self.step_x.signum(),
+        }
+    }
+
     fn new(a: ScreenVertex, b: ScreenVertex, px: i64, py: i64) -> Edge {
         let (dx, dy) = (i64::from(b.x - a.x), i64::from(b.y - a.y));
         // y up: a top edge runs right-to-left horizontally; a left edge runs downward.
         let top_left = ((dy == 0) & (dx < 0)) | (dy < 0);
         let value = dx * (py - i64::from(a.y)) - dy * (px - i64::from(a.x));
         Edge { row: value - i64::from(!top_left), step_x: -dy * ONE, step_y: dx * ONE }
+    }
+}
+
+/// An edge's run bound from row to row without a division per row: `⌊row / |step_x|⌋` kept as a
+/// quotient and remainder and stepped by those of `step_y`. Dividing anew on every row (three
+/// 64-bit divisions a row) was most of the cost of drawing the large triangles of a coarse mesh.
+#[derive(Clone, Copy, Default)]
+struct EdgeRows {
+    quotient: i64,
+    remainder: i64,
+    step_quotient: i64,
+    step_remainder: i64,
+    divisor: i64,
+    sign: i64,
+}
+
+impl EdgeRows {
+    /// What [`Edge::inside`] gives on the current row.
+    fn inside(&self) -> (i64, i64) {
+        match self.sign {
+            1 => (-self.quotient, i64::MAX),
+            -1 => (i64::MIN, self.quotient),
+            _ if self.quotient >= 0 => (i64::MIN, i64::MAX),
+            _ => (1, 0),
+        }
+    }
+
+    fn next_row(&mut self) {
+        self.quotient += self.step_quotient;
+        self.remainder += self.step_remainder;
+        if self.remainder >= self.divisor {
+            self.remainder -= self.divisor;
+            self.quotient += 1;
+        }
     }
 }
 
@@ -465,6 +514,7 @@ fn draw<const DEPTH_TEST: bool>(
         // Offsets from vertex a stay small, so f32 keeps the plane accurate.
         let (ax, ay) = (a.x as f32 / ONE as f32, a.y as f32 / ONE as f32);
         let wide = x1 - x0 >= SPAN_FROM;
+        let mut runs = if wide { edges.map(|e| e.rows()) } else { [EdgeRows::default(); 3] };
         for y in y0..=y1 {
             let row = y as usize * n;
             let zy = a.z + dzdy * (y as f32 + 0.5 - ay);
@@ -484,8 +534,9 @@ fn draw<const DEPTH_TEST: bool>(
             };
             if wide {
                 // The row's run of inside pixels, solved from the edge functions: no test per pixel.
-                let (lo, hi) = edges.iter().fold((0, x1 - x0), |(lo, hi), e| {
+                let (lo, hi) = runs.iter_mut().fold((0, x1 - x0), |(lo, hi), e| {
                     let (from, to) = e.inside();
+                    e.next_row();
                     (lo.max(from), hi.min(to))
                 });
                 (x0 + lo..=x0 + hi).for_each(&mut fragment);
@@ -533,5 +584,27 @@ mod tests {
             }
         }
         assert_eq!(checked, points.len() * points.len() * 3 * 80);
+    }
+
+    /// Stepped row by row, [`EdgeRows`] gives what [`Edge::inside`] gives on each row, for edges
+    /// in every direction (horizontal and vertical ones included), steps of either sign.
+    #[test]
+    fn an_edges_runs_stepped_row_by_row_are_its_inside_runs() {
+        let vertex = |x: i32, y: i32| ScreenVertex { x, y, z: 0.5 };
+        let points = [(0, 0), (37 * ONE as i32 / 3, 5), (-300, 2_000), (4_000, -77), (0, 2_000), (4_000, 0)];
+        let mut rows = 0;
+        for &(ax, ay) in &points {
+            for &(bx, by) in &points {
+                let mut edge = Edge::new(vertex(ax, ay), vertex(bx, by), HALF, -5 * ONE + HALF);
+                let mut runs = edge.rows();
+                for _ in 0..60 {
+                    assert_eq!(runs.inside(), edge.inside(), "edge {ax},{ay} → {bx},{by}, row value {}", edge.row);
+                    edge.row += edge.step_y;
+                    runs.next_row();
+                    rows += 1;
+                }
+            }
+        }
+        assert_eq!(rows, points.len() * points.len() * 60);
     }
 }
