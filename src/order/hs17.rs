@@ -205,7 +205,7 @@ struct Nodes<'a> {
     triangles: &'a [[u32; 3]],
     keyframes: &'a Frames,
     patches: &'a Clustered,
-    /// Each patch's place in `patches`, packed for [`Nodes::buffer`].
+    /// Each patch's place in `patches`, packed for [`Nodes::assemble`].
     spans: Vec<Span>,
     cameras: &'a [Camera],
 }
@@ -228,6 +228,11 @@ impl Span {
             .map(|w| Span { first: patches.order[w[0]], start: w[0] as u32, len: (w[1] - w[0]) as u32 })
             .collect()
     }
+
+    /// The patch's triangle if it has one only, else `u32::MAX`.
+    fn alone(&self) -> u32 {
+        if self.len == 1 { self.first } else { u32::MAX }
+    }
 }
 
 impl Nodes<'_> {
@@ -237,19 +242,7 @@ impl Nodes<'_> {
 
     /// The buffer drawing the patches in `sequence`, each patch a cluster.
     fn buffer(&self, sequence: &[u32]) -> Clustered {
-        let mut order = Vec::with_capacity(self.patches.order.len());
-        let mut starts = Vec::with_capacity(sequence.len() + 1);
-        starts.push(0);
-        for &p in sequence {
-            match self.spans[p as usize] {
-                Span { first, len: 1, .. } => order.push(first),
-                Span { start, len, .. } => {
-                    order.extend_from_slice(&self.patches.order[start as usize..(start + len) as usize])
-                }
-            }
-            starts.push(order.len());
-        }
-        Clustered { order, starts }
+        self.assemble(sequence.iter().map(|&p| (p, self.spans[p as usize].alone())))
     }
 
     /// The patches by increasing `keys` (one per patch), and the buffer drawing them so.
@@ -258,12 +251,17 @@ impl Nodes<'_> {
     /// an entry is 16 bytes either way), so that at λ 3, where nearly every patch is one
     /// triangle, the buffer is written without looking the patches up in random order.
     fn sorted(&self, keys: impl Iterator<Item = f64>) -> (Vec<u32>, Clustered) {
-        let alone = |s: &Span| if s.len == 1 { s.first } else { u32::MAX };
-        let sorted = sort_by_key(keys.zip(self.spans.iter().map(alone)));
+        let sorted = sort_by_key(keys.zip(self.spans.iter().map(Span::alone)));
+        let buffer = self.assemble(sorted.iter().copied());
+        (sorted.into_iter().map(|(p, _)| p).collect(), buffer)
+    }
+
+    /// The buffer drawing `(patch, its lone triangle or u32::MAX)` in sequence.
+    fn assemble(&self, sequence: impl ExactSizeIterator<Item = (u32, u32)>) -> Clustered {
         let mut order = Vec::with_capacity(self.patches.order.len());
-        let mut starts = Vec::with_capacity(sorted.len() + 1);
+        let mut starts = Vec::with_capacity(sequence.len() + 1);
         starts.push(0);
-        for &(p, alone) in &sorted {
+        for (p, alone) in sequence {
             match alone {
                 u32::MAX => {
                     let Span { start, len, .. } = self.spans[p as usize];
@@ -273,7 +271,7 @@ impl Nodes<'_> {
             }
             starts.push(order.len());
         }
-        (sorted.into_iter().map(|(p, _)| p).collect(), Clustered { order, starts })
+        Clustered { order, starts }
     }
 }
 
