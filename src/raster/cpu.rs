@@ -134,9 +134,10 @@ fn named_as_given<T>(result: Result<T>, positions: &[Vec3], cameras: &[Camera], 
 /// A mesh renumbered for locality, for what does not depend on the draw order (a view's
 /// [`DepthLayers`]: its fragments sorted by depth and triangle id): the triangles in Morton order
 /// of their centroids and the vertices by first use, so that consecutive triangles fetch their
-/// corners from nearby memory. In the order as given, a subdivided mesh's corners are spread
-/// over the whole vertex array (Loop subdivision appends the edge vertices), and fetching them
-/// was most of drawing a view of a dense mesh.
+/// corners, and write their fragments' pixels, from nearby memory. Measured on one thread, 162
+/// views: the 100k Buddha at 512² in 0.62 s against 0.75 s in its own order (vertices renumbered
+/// either way); on Xbot subdivided twice at 128² no difference (1.34–1.41 s against 1.28–1.44 s),
+/// its order being local already.
 struct Local {
     /// The positions, by new vertex number; unused vertices last, so that every vertex is still
     /// projected (and a bad one still fails a view).
