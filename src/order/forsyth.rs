@@ -159,6 +159,12 @@ const NONE: u32 = u32::MAX;
 /// Adjacency rows are read in chunks of this many entries (see [`State::draw`]).
 const CHUNK: usize = 8;
 
+/// Where the chunks of a row's first `live` entries start: one chunk at least, even for an empty
+/// row, so that a short row is one pass of a loop whose exit is then predictable.
+fn chunk_starts(live: usize) -> std::iter::StepBy<std::ops::Range<usize>> {
+    (0..live.max(1)).step_by(CHUNK)
+}
+
 /// The low `n` bits set (all of them from [`CHUNK`] on).
 fn live_mask(n: usize) -> u32 {
     if n >= CHUNK { (1 << CHUNK) - 1 } else { (1 << n) - 1 }
@@ -331,17 +337,12 @@ impl<'a> State<'a> {
             // once and masked to the live part: a row's length then decides no branch (most rows
             // are one chunk). The last match, as a degenerate triangle is listed once per corner.
             let mut at = usize::MAX;
-            let mut i = 0;
-            loop {
+            for i in chunk_starts(live) {
                 let chunk = &self.adjacent[start + i..start + i + CHUNK];
                 let hits = chunk.iter().enumerate().fold(0u32, |m, (j, &u)| m | (u32::from(u == t) << j));
-                let hits = hits & live_mask(live.saturating_sub(i));
+                let hits = hits & live_mask(live - i);
                 if hits != 0 {
                     at = start + i + (31 - hits.leading_zeros()) as usize;
-                }
-                i += CHUNK;
-                if i >= live {
-                    break;
                 }
             }
             if at != usize::MAX {
@@ -394,13 +395,8 @@ impl<'a> State<'a> {
             let Vertex { start, live, valence } = vertices[vertex as usize];
             score[vertex as usize] = place_score[place as usize] + valence;
             let (start, live) = (start as usize, live as usize);
-            let mut i = 0;
-            loop {
+            for i in chunk_starts(live) {
                 candidates[count + i..count + i + CHUNK].copy_from_slice(&adjacent[start + i..start + i + CHUNK]);
-                i += CHUNK;
-                if i >= live {
-                    break;
-                }
             }
             count += live;
         }
