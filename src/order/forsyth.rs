@@ -296,7 +296,10 @@ impl<'a> State<'a> {
         State {
             triangles,
             adjacent: vertex_triangles.items().iter().copied().chain([NONE; CHUNK]).collect(),
-            candidates: vec![NONE; (cache + 3) * max_live + CHUNK],
+            // The listed vertices' rows, at most `cache + 3` of the longest, and at most every row:
+            // the second bound keeps a hub's valence times the cache (35 million entries for a
+            // million-triangle fan) from sizing the scratch beyond the adjacency's own size.
+            candidates: vec![NONE; ((cache + 3) * max_live).min(3 * triangles.len()) + CHUNK],
             vertices,
             emitted: vec![false; triangles.len()],
             place_score: scores.places(cache),
