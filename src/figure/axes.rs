@@ -296,7 +296,9 @@ where
         Marker::Diamond => chart.draw_series(
             points.iter().map(|p| at(p) + Polygon::new(vec![(0, -s - 1), (s + 1, 0), (0, s + 1), (-s - 1, 0)], style)),
         )?,
-        Marker::Cross => chart.draw_series(points.iter().map(|p| Cross::new(*p, s, style.stroke_width(2))))?,
+        // At least 2 pixels wide, so that a cross reads as a marker; wider as an outline.
+        Marker::Cross => chart
+            .draw_series(points.iter().map(|p| Cross::new(*p, s, style.stroke_width(style.stroke_width.max(2)))))?,
     };
     Ok(())
 }

@@ -180,11 +180,13 @@ impl Painter for XyPainter<'_> {
                 draw_runs(chart, &runs, color.stroke_width(1))?;
             } else if highlighted(name) && self.lines {
                 draw_runs(chart, &runs, color.stroke_width(3))?;
+                // The black outline beneath and the colour on top: a cross is all outline, and
+                // drawn the other way round it came out black, like every other highlighted cross.
+                axes::markers(chart, &marked, shape, 5, BLACK.stroke_width(3))?;
                 axes::markers(chart, &marked, shape, 5, color.filled())?;
-                axes::markers(chart, &marked, shape, 5, BLACK.stroke_width(1))?;
             } else if highlighted(name) {
+                axes::markers(chart, points, shape, 6, BLACK.stroke_width(4))?;
                 axes::markers(chart, points, shape, 6, color.filled())?;
-                axes::markers(chart, points, shape, 6, BLACK.stroke_width(2))?;
             } else if self.lines {
                 draw_runs(chart, &runs, color.stroke_width(2))?;
                 axes::markers(chart, &marked, shape, 3, color.filled())?;
