@@ -87,6 +87,8 @@
 //!                                  # than 8 series draws the others as grey context
 //! relative_to = "hoppe"            # table with methods as series: each cell is that method's
 //!                                  # value ÷ the cell's (times lower; higher is better)
+//! axes = "own"                     # line, scatter with a facet: each panel's axes fitted to
+//!                                  # its own data (default "shared")
 //!
 //! Figures name methods by what tells them apart (`tipsify cache=8`; the full spec is in the
 //! CSV), grow bars from the metric's optimum where it has one (an overdraw ratio's 1), cut a

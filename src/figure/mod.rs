@@ -122,11 +122,14 @@ pub fn plot(chart: &Chart) -> Result<PathBuf> {
         FigureKind::HardwareFit => return hardware_fit::plot(chart, &table),
         FigureKind::Ratio => return ratio::plot(chart, &table),
     };
-    // Panels share their axes, except panels of different metrics, whose units differ.
+    // Panels share their axes, except panels of different metrics, whose units differ (each
+    // titled by its metric), and those a spec asks to fit on their own.
     let frames = if figure.facet.as_deref() == Some("metric") {
         (0..panels.len())
-            .map(|i| frame(kind.as_ref(), figure, csv, Some((i, &panels[i].title))))
+            .map(|i| frame(kind.as_ref(), figure, csv, Some((i, Some(&panels[i].title)))))
             .collect::<Result<Vec<_>>>()?
+    } else if figure.own_axes {
+        (0..panels.len()).map(|i| frame(kind.as_ref(), figure, csv, Some((i, None)))).collect::<Result<Vec<_>>>()?
     } else {
         vec![frame(kind.as_ref(), figure, csv, None)?]
     };
@@ -261,8 +264,8 @@ fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 
 /// The axes: data extent padded by 5% (multiplicatively on log axes), the spec's y range if it
 /// gives one, and the axis titles. For all panels, or for the one panel `(index, title)` alone
-/// (its y axis then titled by the panel).
-fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &str)>) -> Result<Frame> {
+/// (its y axis then titled by the panel's title where one is given).
+fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, Option<&str>)>) -> Result<Frame> {
     let extent = kind.extent(panel.map(|(i, _)| i));
     let log_error = |key: &str, lo: f64| {
         Error::input(csv.display(), format!("figure.{key} asks for a log axis, but the data has a value {lo} ≤ 0"))
@@ -303,8 +306,8 @@ fn frame(kind: &dyn Kind, figure: &Figure, csv: &Path, panel: Option<(usize, &st
         (None, None) => "values, sorted (percentile)".to_string(),
     };
     let mut y_desc = match panel {
-        Some((_, title)) => title.to_string(),
-        None => figure.y_label.clone().unwrap_or(metric),
+        Some((_, Some(title))) => title.to_string(),
+        _ => figure.y_label.clone().unwrap_or(metric),
     };
     if let Some(o) = optimum.filter(|&o| o == y.start && extent.from_zero) {
         // Bars growing from the optimum: it is the axis itself, so it is named, not drawn.

@@ -75,6 +75,10 @@ pub struct Figure {
     /// Tables of methods: each cell shows this method's value ÷ the cell's (how many times lower
     /// than the reference, the form of Nehab et al.'s "variance drops 50×"); higher is better.
     pub relative_to: Option<String>,
+    /// Each panel's axes fitted to its own data (`axes = "own"`) rather than shared: for facets
+    /// whose values lie far apart, as welded meshes' ACMR near 0.65 beside unwelded ones' 3,
+    /// where shared axes squeeze the differences a panel is about into a sliver.
+    pub own_axes: bool,
 }
 
 /// The chart kinds `triorder plot` draws.
@@ -169,6 +173,7 @@ pub struct RawFigure {
     highlight: Vec<String>,
     relative_to: Option<String>,
     spread: Option<String>,
+    axes: Option<String>,
 }
 
 /// `metric = "acmr"` or `metric = ["ovr_mean", "acmr"]`.
@@ -386,6 +391,15 @@ impl RawFigure {
             }
             r => r.map(|[lo, hi]| (lo, hi)),
         };
+        let own_axes = match self.axes.as_deref() {
+            None | Some("shared") => false,
+            Some("own") if self.facet.is_none() => {
+                return Err("figure.axes = \"own\" fits each panel's axes: it needs figure.facet".into());
+            }
+            Some("own") if matches!(self.kind, FigureKind::Line | FigureKind::Scatter) => true,
+            Some("own") => return Err("figure.axes = \"own\" is for line and scatter charts".into()),
+            Some(other) => return Err(format!("figure.axes = \"{other}\": expected \"shared\" or \"own\"")),
+        };
         Ok(Figure {
             kind: self.kind,
             metric,
@@ -406,6 +420,7 @@ impl RawFigure {
             highlight: self.highlight,
             relative_to: self.relative_to,
             spread: self.spread,
+            own_axes,
         })
     }
 }

@@ -8,11 +8,13 @@
 //! <!-- generated from results/ID.csv: subject=cheap-cuts checks=acmr@cache=fifo:16<=meshopt-vcache+1%/ovr_mean<=meshopt-overdraw/acmr@cache=intel<=best+2%/seconds<=meshopt-overdraw*3 best_from=results/vendor-cache-models.csv tuned=bun_zipper.ply|horse.ply -->
 //! ```
 //!
-//! - `subject`: the `method_name` whose rows are judged.
+//! - `subject`: the `method_name` whose rows are judged; each of its variants (`method`, the
+//!   full spec: a parameter sweep) gets a row of its own, named by what tells it apart.
 //! - `checks`: targets joined by `/`, each `METRIC[@COLUMN=VALUE…]<=REFERENCE[+P%|*F]`: the
 //!   subject's value at most the reference's, plus P percent or times F. REFERENCE is a
-//!   `method_name`, or `best`: the lowest value of any ordering but `input` for that model (and
-//!   conditions) in the `best_from` CSV where it has the model, else in this one.
+//!   `method_name` run in one variant only, a full `method` spec (`meshopt-overdraw:threshold=1.05`:
+//!   one variant of a sweep), or `best`: the lowest value of any ordering but `input` for that
+//!   model (and conditions) in the `best_from` CSV where it has the model, else in this one.
 //! - `best_from` (optional): the CSV `best` is read from first (a spec that runs every ordering).
 //! - `tuned` (optional): the model files a method's defaults were tuned on, `|`-separated; adds a
 //!   `set` column (tuned or held out) and lists the tuned models first.
@@ -20,7 +22,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::data::{Table, thousands};
+use super::data::{Table, display_names, thousands};
 use crate::error::{Error, Result};
 
 /// One verdict table's recipe.
@@ -115,22 +117,46 @@ impl Verdicts {
         if models.is_empty() {
             return Err(Error::input(&path, format!("no rows of subject = {}", self.subject)));
         }
+        // The subject's variants, named by what tells them apart; a column only if it has several.
+        let variants: Vec<String> = table
+            .distinct(&["method_name", "method"])
+            .into_iter()
+            .filter(|m| m[0] == self.subject)
+            .map(|mut m| m.swap_remove(1))
+            .collect();
+        let names = display_names(&variants);
+        let several = variants.len() > 1;
         let mut out = String::new();
         let set = if self.tuned.is_some() { " set |" } else { "" };
+        let variant = if several { " variant |" } else { "" };
         let titles: Vec<String> = self.checks.iter().map(Check::title).collect();
-        let _ = writeln!(out, "| model |{set} {} |", titles.join(" | "));
-        let _ = writeln!(out, "|---|{}", "---|".repeat(titles.len() + usize::from(self.tuned.is_some())));
+        let _ = writeln!(out, "| model |{set}{variant} {} |", titles.join(" | "));
+        let columns = titles.len() + usize::from(self.tuned.is_some()) + usize::from(several);
+        let _ = writeln!(out, "|---|{}", "---|".repeat(columns));
         for (model, triangles) in &models {
-            let mut cells = Vec::new();
-            for check in &self.checks {
-                cells.push(check.verdict(&table, best_from.as_ref(), &self.subject, model)?);
-            }
             let set = match &self.tuned {
                 Some(_) if is_tuned(model) => " tuned |",
                 Some(_) => " held out |",
                 None => "",
             };
-            let _ = writeln!(out, "| {} ({}) |{set} {} |", file(model), thousands(triangles), cells.join(" | "));
+            let run = table.distinct(&["model", "method"]);
+            for (spec, name) in variants.iter().zip(&names) {
+                if !run.contains(&vec![model.clone(), spec.clone()]) {
+                    continue;
+                }
+                let mut cells = Vec::new();
+                for check in &self.checks {
+                    cells.push(check.verdict(&table, best_from.as_ref(), spec, model)?);
+                }
+                let variant = if several { format!(" {name} |") } else { String::new() };
+                let _ = writeln!(
+                    out,
+                    "| {} ({}) |{set}{variant} {} |",
+                    file(model),
+                    thousands(triangles),
+                    cells.join(" | ")
+                );
+            }
         }
         Ok(out)
     }
@@ -175,26 +201,49 @@ impl Check {
         format!("{}{conditions} ≤ {limit}", self.metric)
     }
 
-    /// `(method_name, value)` of every row of this check's metric and conditions for `model`.
-    fn values(&self, table: &Table, model: &str) -> Result<Vec<(String, f64)>> {
-        let mut columns = vec!["model", "method_name"];
+    /// `(method_name, method, value)` of every row of this check's metric and conditions for
+    /// `model`.
+    fn values(&self, table: &Table, model: &str) -> Result<Vec<(String, String, f64)>> {
+        let mut columns = vec!["model", "method_name", "method"];
         columns.extend(self.conditions.iter().map(|(c, _)| c.as_str()));
         Ok(table
             .rows(&self.metric, &columns)?
             .into_iter()
-            .filter(|(cells, _)| cells[0] == model && self.conditions.iter().zip(&cells[2..]).all(|((_, v), c)| v == c))
-            .map(|(mut cells, value)| (cells.swap_remove(1), value))
+            .filter(|(cells, _)| cells[0] == model && self.conditions.iter().zip(&cells[3..]).all(|((_, v), c)| v == c))
+            .map(|(cells, value)| (cells[1].clone(), cells[2].clone(), value))
             .collect())
     }
 
-    /// "yes" or "**no**", with the subject's value against the reference's.
+    /// "yes" or "**no**", with the value of `subject` (a full method spec) against the
+    /// reference's.
     fn verdict(&self, table: &Table, best_from: Option<&Table>, subject: &str, model: &str) -> Result<String> {
         let here = self.values(table, model)?;
         let path = table.path().display().to_string();
         let missing = |what: &str| Error::input(&path, format!("no `{}` row of {what} on {model}", self.title()));
-        let ours = here.iter().find(|(name, _)| name == subject).map(|r| r.1).ok_or_else(|| missing(subject))?;
+        let ours = here.iter().find(|(_, spec, _)| spec == subject).map(|r| r.2).ok_or_else(|| missing(subject))?;
         let (name, reference) = match &self.against {
-            Against::Method(name) => here.iter().find(|(n, _)| n == name).cloned().ok_or_else(|| missing(name))?,
+            Against::Method(name) => {
+                // A spec names one variant; a bare name must have only one on the model.
+                let matching: Vec<&(String, String, f64)> = here
+                    .iter()
+                    .filter(|(n, spec, _)| if name.contains(':') { spec == name } else { n == name })
+                    .collect();
+                match matching.as_slice() {
+                    [] => return Err(missing(name)),
+                    [(n, _, v)] => (n.clone(), *v),
+                    several => {
+                        let specs: Vec<&str> = several.iter().map(|(_, spec, _)| spec.as_str()).collect();
+                        return Err(Error::input(
+                            &path,
+                            format!(
+                                "`{}`: {name} ran as {} on {model}; name one by its spec",
+                                self.title(),
+                                specs.join(", ")
+                            ),
+                        ));
+                    }
+                }
+            }
             Against::Best => {
                 let everywhere = match best_from {
                     Some(other) => self.values(other, model)?,
@@ -202,7 +251,8 @@ impl Check {
                 };
                 let pool = if everywhere.is_empty() { here } else { everywhere };
                 pool.into_iter()
-                    .filter(|(name, _)| name != "input")
+                    .filter(|(name, _, _)| name != "input")
+                    .map(|(name, _, value)| (name, value))
                     .min_by(|a, b| a.1.total_cmp(&b.1).then_with(|| a.0.cmp(&b.0)))
                     .ok_or_else(|| missing("any ordering"))?
             }
@@ -222,17 +272,17 @@ impl Check {
 mod tests {
     use super::*;
 
-    const CSV: &str = "model,model_triangles,method_name,metric,cache,value
-models/a.ply,100,ours,acmr,fifo:16,0.70
-models/a.ply,100,peer,acmr,fifo:16,0.695
-models/a.ply,100,other,acmr,fifo:16,0.60
-models/a.ply,100,input,acmr,fifo:16,0.50
-models/a.ply,100,ours,seconds,,0.4
-models/a.ply,100,peer,seconds,,0.1
-models/b.ply,2000,ours,acmr,fifo:16,0.80
-models/b.ply,2000,peer,acmr,fifo:16,0.70
-models/b.ply,2000,ours,seconds,,0.2
-models/b.ply,2000,peer,seconds,,0.1
+    const CSV: &str = "model,model_triangles,method_name,method,metric,cache,value
+models/a.ply,100,ours,ours,acmr,fifo:16,0.70
+models/a.ply,100,peer,peer,acmr,fifo:16,0.695
+models/a.ply,100,other,other,acmr,fifo:16,0.60
+models/a.ply,100,input,input,acmr,fifo:16,0.50
+models/a.ply,100,ours,ours,seconds,,0.4
+models/a.ply,100,peer,peer,seconds,,0.1
+models/b.ply,2000,ours,ours,acmr,fifo:16,0.80
+models/b.ply,2000,peer,peer,acmr,fifo:16,0.70
+models/b.ply,2000,ours,ours,seconds,,0.2
+models/b.ply,2000,peer,peer,seconds,,0.1
 ";
 
     #[test]
@@ -256,7 +306,7 @@ models/b.ply,2000,peer,seconds,,0.1
         std::fs::write(dir.path().join("x.csv"), CSV).unwrap();
         std::fs::write(
             dir.path().join("all.csv"),
-            "model,model_triangles,method_name,metric,cache,value\nmodels/a.ply,100,wide,acmr,fifo:16,0.69\n",
+            "model,model_triangles,method_name,method,metric,cache,value\nmodels/a.ply,100,wide,wide,acmr,fifo:16,0.69\n",
         )
         .unwrap();
         let recipe =
@@ -264,6 +314,29 @@ models/b.ply,2000,peer,seconds,,0.1
         let table = recipe.table(dir.path()).unwrap();
         assert!(table.contains("| a.ply (100) | yes (+1.4% vs wide) |"), "{table}");
         assert!(table.contains("| b.ply (2,000) | **no** (+14.3% vs peer) |"), "{table}");
+    }
+
+    /// A swept subject gets a row per variant, named by the parameter that differs; a swept
+    /// reference must be named by its spec, as a bare name could mean any of its runs.
+    #[test]
+    fn each_variant_of_a_sweep_is_judged_and_a_swept_reference_is_named_by_spec() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("x.csv"),
+            "model,model_triangles,method_name,method,metric,value\n\
+models/a.ply,100,ours,ours:k=1,acmr,0.70\n\
+models/a.ply,100,ours,ours:k=2,acmr,0.80\n\
+models/a.ply,100,peer,peer:t=1,acmr,0.75\n\
+models/a.ply,100,peer,peer:t=2,acmr,0.72\n",
+        )
+        .unwrap();
+        let table = Verdicts::parse("x.csv: subject=ours checks=acmr<=peer:t=2").unwrap().table(dir.path()).unwrap();
+        let want = "| model | variant | acmr ≤ peer:t=2 |\n|---|---|---|\n\
+| a.ply (100) | ours k=1 | yes (-2.8% vs peer) |\n\
+| a.ply (100) | ours k=2 | **no** (+11.1% vs peer) |\n";
+        assert_eq!(table, want);
+        let ambiguous = Verdicts::parse("x.csv: subject=ours checks=acmr<=peer").unwrap().table(dir.path());
+        assert!(ambiguous.is_err_and(|e| e.to_string().contains("name one by its spec")));
     }
 
     #[test]
