@@ -133,13 +133,13 @@ impl Verdicts {
         let _ = writeln!(out, "| model |{set}{variant} {} |", titles.join(" | "));
         let columns = titles.len() + usize::from(self.tuned.is_some()) + usize::from(several);
         let _ = writeln!(out, "|---|{}", "---|".repeat(columns));
+        let run = table.distinct(&["model", "method"]);
         for (model, triangles) in &models {
             let set = match &self.tuned {
                 Some(_) if is_tuned(model) => " tuned |",
                 Some(_) => " held out |",
                 None => "",
             };
-            let run = table.distinct(&["model", "method"]);
             for (spec, name) in variants.iter().zip(&names) {
                 if !run.contains(&vec![model.clone(), spec.clone()]) {
                     continue;

@@ -316,8 +316,14 @@ impl<'a> State<'a> {
             .collect();
         let score: Vec<f32> = vertices.iter().map(|v| v.valence).collect();
         // What the unchecked reads in `rescore` rest on.
-        assert!(vertex_triangles.items().iter().all(|&t| (t as usize) < triangles.len()), "adjacency names a triangle");
-        assert!(triangles.iter().flatten().all(|&v| (v as usize) < score.len()), "a corner outside the adjacency");
+        assert!(
+            vertex_triangles.items().iter().all(|&t| (t as usize) < triangles.len()),
+            "the adjacency names a triangle the mesh does not have"
+        );
+        assert!(
+            triangles.iter().flatten().all(|&v| (v as usize) < score.len()),
+            "a triangle's corner is a vertex the adjacency does not have"
+        );
         State {
             triangles,
             adjacent: vertex_triangles.items().iter().copied().chain([NONE; CHUNK]).collect(),
