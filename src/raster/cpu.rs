@@ -331,74 +331,114 @@ fn check_resolution(res: u32) -> Result<()> {
 /// range (it would need clipping, which the view sets are framed never to need) or far off
 /// screen.
 fn project(unit: &[Vec3], camera: &Camera, res: u32, out: &mut Vec<ScreenVertex>) -> std::result::Result<(), String> {
-    let scale = 0.5 * res as f32 * ONE as f32;
-    let limit = (8 * i64::from(res) * ONE) as f32;
-    // One pass without early exits (a fault is folded into a flag, so the loop has no branch),
+    let lanes = Lanes::new(camera, res);
+    // Four at a time, the last quad padded with copies of the last vertex (their lanes dropped).
+    let (quads, rest) = unit.as_chunks::<4>();
+    let last = rest.first().map(|_| std::array::from_fn(|k| rest[k.min(rest.len() - 1)]));
+    // One pass without early exits (faults are folded into a mask, so the loop has no branch),
     // then, in the rare case of a fault, a second pass to name the first bad vertex.
-    let mut faults = 0u8;
+    let mut faults = 0;
     out.clear();
-    out.extend(unit.iter().map(|&p| {
-        let (vertex, fault) = snap(p, camera, scale, limit);
-        faults |= fault;
-        vertex
-    }));
+    out.reserve(unit.len() + 3);
+    for quad in quads.iter().chain(&last) {
+        let (vertices, outside, far) = lanes.snap(quad);
+        faults |= outside | far;
+        out.extend_from_slice(&vertices);
+    }
+    out.truncate(unit.len());
     if faults == 0 {
         return Ok(());
     }
-    let (i, fault) =
-        unit.iter().map(|&p| snap(p, camera, scale, limit).1).enumerate().find(|&(_, f)| f != 0).unwrap_or((0, faults));
-    Err(if fault & 1 != 0 {
+    let (i, outside) = quads
+        .iter()
+        .chain(&last)
+        .enumerate()
+        .find_map(|(i, quad)| {
+            let (_, outside, far) = lanes.snap(quad);
+            let lane = (outside | far).trailing_zeros();
+            (lane < 4).then(|| (4 * i + lane as usize, outside >> lane & 1 != 0))
+        })
+        .expect("a fault has a vertex");
+    Err(if outside {
         format!("vertex {i} lies outside the camera's depth range (clipping is not supported)")
     } else {
         format!("vertex {i} projects far outside the image")
     })
 }
 
-/// One vertex through the camera, the perspective divide and the viewport, snapped; and its
-/// fault: bit 0 when it lies outside the depth range (behind the eye or past the far plane),
-/// bit 1 when it lands farther than `limit` (in sub-pixels) off the image.
-fn snap(p: Vec3, camera: &Camera, scale: f32, limit: f32) -> (ScreenVertex, u8) {
-    let clip = camera.view_proj * p.extend(1.0);
-    // One vector division (each lane rounds as the scalar division would).
-    let ndc = clip / Vec4::splat(clip.w);
-    let (x, y) = ((ndc.x + 1.0) * scale, (ndc.y + 1.0) * scale);
-    let outside_depth = !((clip.w > 0.0) & (ndc.z >= 0.0) & (ndc.z <= 1.0));
-    let far = !((x.abs() < limit) & (y.abs() < limit));
-    let (x, y) = round_pair(x, y);
-    (ScreenVertex { x, y, z: ndc.z }, u8::from(outside_depth) | u8::from(far) << 1)
+/// A camera's transform split into lanes: `m[r][c]` holds the matrix entry of row `r`, column
+/// `c` in all four lanes, so four vertices go through it at once, one a lane. Each lane does the
+/// operations of `view_proj * p.extend(1.0)` in glam's order (the columns scaled by x, y, z and 1
+/// and summed left to right; scaling by 1 is exact and left out), so a vertex snaps to the same
+/// bits as transformed alone; projecting took a sixth of drawing a dense mesh's views, 51
+/// instructions a vertex one at a time.
+struct Lanes {
+    m: [[Vec4; 4]; 4],
+    /// Sub-pixels per NDC unit.
+    scale: Vec4,
+    /// Farther off the image than this (in sub-pixels) a vertex is refused.
+    limit: Vec4,
 }
 
-/// `x` and `y` rounded half away from zero, as [`f32::round`], for |x|, |y| below 2³¹ (beyond, a
-/// vertex is refused as far off the image and the values are not used). Written out because
-/// `f32::round` is a libc call on baseline x86-64 (no SSE4.1), which cost 7% of an overdraw
-/// count; on x86-64 both in one SSE2 register, without the checks a saturating `as i32` adds
-/// (projecting took a sixth of drawing a dense mesh's views).
+impl Lanes {
+    fn new(camera: &Camera, res: u32) -> Lanes {
+        let columns = camera.view_proj.to_cols_array_2d();
+        Lanes {
+            m: std::array::from_fn(|r| std::array::from_fn(|c| Vec4::splat(columns[c][r]))),
+            scale: Vec4::splat(0.5 * res as f32 * ONE as f32),
+            limit: Vec4::splat((8 * i64::from(res) * ONE) as f32),
+        }
+    }
+
+    /// Four vertices through the camera, the perspective divide and the viewport, snapped; and
+    /// their faults, bit `k` for the `k`-th: the ones outside the depth range (behind the eye or
+    /// past the far plane), and the ones farther than `limit` off the image.
+    fn snap(&self, quad: &[Vec3; 4]) -> ([ScreenVertex; 4], u32, u32) {
+        let (x, y, z) = (
+            Vec4::from_array(quad.map(|p| p.x)),
+            Vec4::from_array(quad.map(|p| p.y)),
+            Vec4::from_array(quad.map(|p| p.z)),
+        );
+        let clip = |[mx, my, mz, mw]: &[Vec4; 4]| ((*mx * x + *my * y) + *mz * z) + *mw;
+        let [cx, cy, cz, cw] = self.m.each_ref().map(clip);
+        let (nx, ny, nz) = (cx / cw, cy / cw, cz / cw);
+        let (sx, sy) = ((nx + Vec4::ONE) * self.scale, (ny + Vec4::ONE) * self.scale);
+        let inside_depth = cw.cmpgt(Vec4::ZERO) & nz.cmpge(Vec4::ZERO) & nz.cmple(Vec4::ONE);
+        let near = sx.abs().cmplt(self.limit) & sy.abs().cmplt(self.limit);
+        let (rx, ry, nz) = (round4(sx), round4(sy), nz.to_array());
+        let vertices = std::array::from_fn(|k| ScreenVertex { x: rx[k], y: ry[k], z: nz[k] });
+        (vertices, !inside_depth.bitmask() & 0xf, !near.bitmask() & 0xf)
+    }
+}
+
+/// Each lane rounded half away from zero, as [`f32::round`], for values below 2³¹ in magnitude
+/// (beyond, a vertex is refused as far off the image and the values are not used). Written out
+/// because `f32::round` is a libc call on baseline x86-64 (no SSE4.1), which cost 7% of an
+/// overdraw count; on x86-64 in one SSE2 register, without the checks a saturating `as i32` adds.
 #[cfg(target_arch = "x86_64")]
-fn round_pair(x: f32, y: f32) -> (i32, i32) {
+fn round4(v: Vec4) -> [i32; 4] {
     use std::arch::x86_64::*;
     // SAFETY: these are SSE and SSE2 instructions, part of every x86-64 processor (the target's
     // baseline); none touches memory.
     unsafe {
-        let v = _mm_setr_ps(x, y, 0.0, 0.0);
+        let v: __m128 = v.into();
         let whole = _mm_cvttps_epi32(v);
         // Exact: `whole` and `v` share their sign and `whole` drops only the fraction.
         let fraction = _mm_sub_ps(v, _mm_cvtepi32_ps(whole));
         // Comparison masks are −1 where true.
         let up = _mm_castps_si128(_mm_cmpge_ps(fraction, _mm_set1_ps(0.5)));
         let down = _mm_castps_si128(_mm_cmple_ps(fraction, _mm_set1_ps(-0.5)));
-        let rounded = _mm_add_epi32(_mm_sub_epi32(whole, up), down);
-        (_mm_cvtsi128_si32(rounded), _mm_cvtsi128_si32(_mm_shuffle_epi32(rounded, 1)))
+        std::mem::transmute::<__m128i, [i32; 4]>(_mm_add_epi32(_mm_sub_epi32(whole, up), down))
     }
 }
 
 #[cfg(not(target_arch = "x86_64"))]
-fn round_pair(x: f32, y: f32) -> (i32, i32) {
-    let round = |x: f32| {
+fn round4(v: Vec4) -> [i32; 4] {
+    v.to_array().map(|x| {
         let whole = x as i32;
         let fraction = x - whole as f32;
         whole + i32::from(fraction >= 0.5) - i32::from(fraction <= -0.5)
-    };
-    (round(x), round(y))
+    })
 }
 
 /// An edge function `E(p) = (b − a) × (p − a)`, positive inside a counter-clockwise triangle,
@@ -618,10 +658,60 @@ mod tests {
         let mut values = vec![0.5, -0.5, 1.5, -1.5, 2.5, 0.49999997, -0.49999997, 8_388_607.5, -8_388_607.5];
         values.extend((-4000..4000).map(|i| i as f32 * 0.37 + 0.125));
         values.extend((0..2000).map(|i| (i as f32 - 1000.0) * 33_554.43));
-        for pair in values.chunks(2) {
-            let (x, y) = (pair[0], *pair.get(1).unwrap_or(&0.0));
-            assert_eq!(round_pair(x, y), (x.round() as i32, y.round() as i32), "{x}, {y}");
+        for quad in values.chunks(4) {
+            let lanes: [f32; 4] = std::array::from_fn(|k| *quad.get(k).unwrap_or(&0.0));
+            assert_eq!(round4(Vec4::from_array(lanes)), lanes.map(|x| x.round() as i32), "{lanes:?}");
         }
+    }
+
+    /// Four vertices a lane at a time snap to the same bits as each alone through the camera's
+    /// matrix (`view_proj * p.extend(1.0)`, the perspective divide, the viewport, `f32::round`),
+    /// with the same faults: behind the eye, past the far plane, far off the image.
+    #[test]
+    fn lanes_snap_as_the_matrix_does_one_vertex() {
+        use crate::mesh::Framing;
+        use crate::raster::views::{ViewSet, perspective};
+        let framing = Framing::of(&[Vec3::splat(-1.0), Vec3::splat(1.0)]);
+        let mut cameras = ViewSet::Ico(42).cameras(framing, 0);
+        cameras.extend(ViewSet::Random(8).cameras(framing, 3));
+        cameras.push(perspective(framing, Vec3::new(0.3, -0.8, 0.5)));
+        let mut seed = 12345u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut points: Vec<Vec3> = (0..4000).map(|_| Vec3::new(next(), next(), next()) * 1.2).collect();
+        // Past the far plane, behind the eye, and far off to one side.
+        points.extend([Vec3::splat(40.0), Vec3::splat(-40.0), Vec3::new(0.0, 30.0, 0.0), Vec3::ZERO]);
+        let (mut faults, mut checked) = (0, 0);
+        for camera in &cameras {
+            for res in [64, 512] {
+                let lanes = Lanes::new(camera, res);
+                let (scale, limit) = (0.5 * res as f32 * ONE as f32, (8 * i64::from(res) * ONE) as f32);
+                for quad in points.as_chunks::<4>().0 {
+                    let (vertices, outside, far) = lanes.snap(quad);
+                    let fault = std::array::from_fn::<u8, 4, _>(|k| (outside >> k & 1 | (far >> k & 1) << 1) as u8);
+                    for ((p, v), f) in quad.iter().zip(vertices).zip(fault) {
+                        let clip = camera.view_proj * p.extend(1.0);
+                        let ndc = clip / Vec4::splat(clip.w);
+                        let (x, y) = ((ndc.x + 1.0) * scale, (ndc.y + 1.0) * scale);
+                        let outside = !((clip.w > 0.0) & (ndc.z >= 0.0) & (ndc.z <= 1.0));
+                        let far = !((x.abs() < limit) & (y.abs() < limit));
+                        assert_eq!(f, u8::from(outside) | u8::from(far) << 1, "{p} fault");
+                        if f == 0 {
+                            assert_eq!(
+                                (v.x, v.y, v.z.to_bits()),
+                                (x.round() as i32, y.round() as i32, ndc.z.to_bits()),
+                                "{p}"
+                            );
+                            checked += 1;
+                        }
+                        faults += usize::from(f != 0);
+                    }
+                }
+            }
+        }
+        assert!(checked > 100_000 && faults >= cameras.len() * 2, "{checked} snapped, {faults} faults");
     }
 
     /// Stepped row by row, [`EdgeRows`] gives what [`Edge::inside`] gives on each row, for edges
