@@ -344,18 +344,13 @@ impl<'a> State<'a> {
         }
     }
 
-    /// The score of live triangle `t`.
-    fn score(&self, t: u32) -> f32 {
-        self.triangles[t as usize].iter().map(|&v| self.score[v as usize]).sum()
-    }
-
     /// The best-scoring live triangle of vertex `v` (the first on ties).
     fn best_of(&self, v: u32) -> u32 {
         let Vertex { start, live, .. } = self.vertices[v as usize];
         let row = &self.adjacent[start as usize..(start + live) as usize];
         row.iter()
             .fold((NONE, f32::NEG_INFINITY), |best, &t| {
-                let score = self.score(t);
+                let score = triangle_score(self.triangles, &self.score, t);
                 if score > best.1 { (t, score) } else { best }
             })
             .0
@@ -435,12 +430,7 @@ impl<'a> State<'a> {
         }
         let (mut best, mut best_score) = (NONE, f32::NEG_INFINITY);
         for &t in &candidates[..count] {
-            // SAFETY: the candidates are adjacency entries, which `State::new` checked are
-            // triangles of `triangles`, whose corners it checked are vertices of `score`.
-            let sum = unsafe {
-                let [a, b, c] = *triangles.get_unchecked(t as usize);
-                score.get_unchecked(a as usize) + score.get_unchecked(b as usize) + score.get_unchecked(c as usize)
-            };
+            let sum = triangle_score(triangles, score, t);
             if sum > best_score {
                 best_score = sum;
                 best = t;
@@ -463,6 +453,17 @@ impl<'a> State<'a> {
     fn settle(&mut self) {
         self.lru_len = self.next_len - self.evicted().len();
         std::mem::swap(&mut self.lru, &mut self.next);
+    }
+}
+
+/// The sum of the scores of adjacency entry `t`'s corners, in corner order.
+#[inline(always)]
+fn triangle_score(triangles: &[[u32; 3]], score: &[f32], t: u32) -> f32 {
+    // SAFETY: `t` is an adjacency entry, which `State::new` checked is a triangle of
+    // `triangles`, whose corners it checked are vertices of `score`.
+    unsafe {
+        let [a, b, c] = *triangles.get_unchecked(t as usize);
+        score.get_unchecked(a as usize) + score.get_unchecked(b as usize) + score.get_unchecked(c as usize)
     }
 }
 
