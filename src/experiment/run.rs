@@ -5,7 +5,7 @@
 //! model. Every model goes through the same path: a static mesh is one frame, an animation
 //! (`PATH#clip=…`) its keyframes, and every method is measured over the frames with the index
 //! buffers it picks per (frame, view) (Han & Sander 2017, §4). Orderings run one after another so
-//! their wall times are honest; only the rasterizer runs in parallel, inside one measurement. The
+//! their wall times are honest; only measurements run in parallel (views, cache models, orders). The
 //! CSV is written atomically at the end: an interrupted run leaves the previous results untouched.
 
 use std::collections::{HashMap, HashSet};

@@ -22,6 +22,7 @@
 //! frame's positions and the buffer that draws each view.
 
 use meshopt::Meshlets;
+use rayon::prelude::*;
 
 use super::{Draws, MeasureOptions, Metric, Name, Value};
 use crate::error::Result;
@@ -145,6 +146,12 @@ impl Metric for MeshletMetrics {
             }
         }
         Ok(values)
+    }
+
+    /// The orders in parallel: meshoptimizer's builders are pure functions of their input, so
+    /// the values are those of measuring the orders one by one.
+    fn measure_many(&self, many: &[Draws]) -> Result<Vec<Vec<Value>>> {
+        many.par_iter().map(|draws| self.measure(draws)).collect()
     }
 
     fn columns(&self, values: &[&Value]) -> Vec<(String, String)> {
