@@ -7,7 +7,7 @@ use std::time::Instant;
 use indicatif::ProgressBar;
 
 use crate::error::{Error, Result};
-use crate::experiment::run::{OrderMemo, bars, run_spec, style};
+use crate::experiment::run::{RunMemo, bars, run_spec, style};
 use crate::experiment::{RunOptions, Spec};
 use crate::figure::{self, PlotOptions};
 
@@ -80,9 +80,9 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
     let bars = bars(opts.progress);
     let overall = bars.add(ProgressBar::new(specs.len() as u64));
     overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));
-    // Orders shared between specs, over the specs that will run.
+    // Orders and views' layers shared between specs, over the specs that will run.
     let mut memo =
-        OrderMemo::for_specs(specs.iter().filter(|s| !gpu(s) || device.as_ref().is_some_and(|d| d.is_ok())), opts)?;
+        RunMemo::for_specs(specs.iter().filter(|s| !gpu(s) || device.as_ref().is_some_and(|d| d.is_ok())), opts)?;
     let plot = PlotOptions { quick: opts.quick, out_dir: opts.out_dir.clone(), data: opts.data.clone() };
     let mut outcome = Outcome::default();
     for spec in &specs {

@@ -25,7 +25,8 @@ use crate::measure::{self, Evaluation, cache};
 use crate::mesh::progressive::Update;
 use crate::mesh::{Mesh, Scene, source};
 use crate::order::{self, Clustered, Orders, Resolved};
-use crate::raster::{cpu, views};
+use crate::raster::kept::{KeptLayers, LayerMemo};
+use crate::raster::{RasterBackend, cpu, views};
 use crate::results::{COLUMNS, Context, ORDER_COLUMNS, OrderRow, Row};
 
 /// How to run experiments.
@@ -85,35 +86,75 @@ pub struct Failure {
 /// Runs the spec at `spec` and writes its CSV (or the shard's file).
 pub fn run(spec: &Path, opts: &RunOptions) -> Result<Outcome> {
     let spec = Spec::load(spec)?;
-    run_spec(&spec, opts, &bars(opts.progress), &mut OrderMemo::default())
+    run_spec(&spec, opts, &bars(opts.progress), &mut RunMemo::default())
 }
 
-/// Orders that one spec of a run computes and a later spec asks for again: the same model opened
-/// the same way (source, seed, levels, update), the same method with the same parameters, under
-/// the same draw-call rule, which make the same orders. `reproduce` runs every spec with one, so a
-/// model's orders are computed once however many specs measure them (several order "all"
-/// methods on the same shared models). A reused order keeps the seconds it took when it was
-/// computed, its own time, as [`crate::mesh::scene::SharedWork`] charges a reuse. Only orders a
-/// later spec asks for are kept, each until the last spec that asks for it has run.
+/// What one spec of a run computes and a later spec asks for again, kept between them:
+/// - orders: the same model opened the same way (source, seed, levels, update), the same method
+///   with the same parameters, under the same draw-call rule, which make the same orders. Several
+///   specs order "all" methods on the same shared models; each order is computed once. A reused
+///   order keeps the seconds it took when it was computed, its own time, as
+///   [`crate::mesh::scene::SharedWork`] charges a reuse.
+/// - views' depth layers ([`LayerMemo`]): the same model opened the same way, measured on the
+///   CPU from the same view set at the same size. Six specs measure Soldier's keyframes from the
+///   same 300 views, each with orders of its own; each view is rasterized once.
+///
+/// `reproduce` runs every spec with one. Only what a later spec asks for is kept, each until the
+/// last spec that asks for it has run.
 #[derive(Default)]
-pub struct OrderMemo {
-    /// Per key, the specs still to run that ask for it.
-    wanted: HashMap<String, HashSet<String>>,
+pub struct RunMemo {
+    orders: Claims,
     kept: HashMap<String, Evaluation>,
+    views: Claims,
+    layers: LayerMemo,
 }
 
-impl OrderMemo {
+/// Per key, the specs still to run that ask for it; only keys two or more specs ask for.
+#[derive(Default)]
+struct Claims(HashMap<String, HashSet<String>>);
+
+impl Claims {
+    fn of(keys: impl IntoIterator<Item = (String, String)>) -> Claims {
+        let mut claims: HashMap<String, HashSet<String>> = HashMap::new();
+        for (key, spec) in keys {
+            claims.entry(key).or_default().insert(spec);
+        }
+        claims.retain(|_, specs| specs.len() > 1);
+        Claims(claims)
+    }
+
+    /// Whether a spec other than `spec` still to run asks for `key`.
+    fn by_another(&self, key: &str, spec: &str) -> bool {
+        self.0.get(key).is_some_and(|specs| specs.iter().any(|s| s != spec))
+    }
+
+    fn contains(&self, key: &str) -> bool {
+        self.0.contains_key(key)
+    }
+
+    /// Forgets `spec`'s claims once it has run.
+    fn finished(&mut self, spec: &str) {
+        self.0.retain(|_, specs| {
+            specs.remove(spec);
+            !specs.is_empty()
+        });
+    }
+}
+
+impl RunMemo {
     /// A memo for running `specs` in turn under `opts`.
-    pub fn for_specs<'s>(specs: impl IntoIterator<Item = &'s Spec>, opts: &RunOptions) -> Result<OrderMemo> {
-        let mut wanted: HashMap<String, HashSet<String>> = HashMap::new();
+    pub fn for_specs<'s>(specs: impl IntoIterator<Item = &'s Spec>, opts: &RunOptions) -> Result<RunMemo> {
+        let (mut orders, mut views) = (Vec::new(), Vec::new());
         for spec in specs {
             let plan = Plan::new(spec, opts)?;
             for u in 0..plan.units.len() {
-                wanted.entry(plan.key(spec, opts, u)?).or_default().insert(spec.id.clone());
+                orders.push((plan.key(spec, opts, u)?, spec.id.clone()));
+            }
+            for m in 0..plan.models.len() {
+                views.extend(plan.view_key(spec, opts, m)?.map(|key| (key, spec.id.clone())));
             }
         }
-        wanted.retain(|_, specs| specs.len() > 1);
-        Ok(OrderMemo { wanted, kept: HashMap::new() })
+        Ok(RunMemo { orders: Claims::of(orders), views: Claims::of(views), ..RunMemo::default() })
     }
 
     /// The evaluation for `key` asked for by `spec`: the one kept, or what `order` gives, kept
@@ -123,19 +164,33 @@ impl OrderMemo {
             return Ok(kept.clone());
         }
         let evaluation = order()?;
-        if self.wanted.get(&key).is_some_and(|specs| specs.iter().any(|s| s != spec)) {
+        if self.orders.by_another(&key, spec) {
             self.kept.insert(key, evaluation.clone());
         }
         Ok(evaluation)
     }
 
-    /// Forgets `spec`'s claims once it has run, dropping the orders no spec still to run asks for.
+    /// The CPU backend keeping views' layers under `key` (a [`Plan::view_key`]) when another spec
+    /// asks for them; `None` when none does.
+    fn kept_layers(&self, spec: &str, key: Option<String>) -> Option<KeptLayers<'_>> {
+        let key = key.filter(|k| self.views.contains(k))?;
+        Some(KeptLayers { memo: &self.layers, keep: self.views.by_another(&key, spec), tag: key })
+    }
+
+    /// Drops the layers kept under `key` once `spec` has measured its model with them and no
+    /// later spec asks for them: the specs after it need not hold them (Soldier's take 1.8 GB).
+    fn measured(&self, spec: &str, key: &str) {
+        if !self.views.by_another(key, spec) {
+            self.layers.retain(|k| k != key);
+        }
+    }
+
+    /// Forgets `spec`'s claims once it has run, dropping what no spec still to run asks for.
     fn finished(&mut self, spec: &str) {
-        self.wanted.retain(|_, specs| {
-            specs.remove(spec);
-            !specs.is_empty()
-        });
-        self.kept.retain(|key, _| self.wanted.contains_key(key));
+        self.orders.finished(spec);
+        self.views.finished(spec);
+        self.kept.retain(|key, _| self.orders.contains(key));
+        self.layers.retain(|key| self.views.contains(key));
     }
 }
 
@@ -165,7 +220,7 @@ impl<'a> Plan<'a> {
         Ok(Plan { models, methods, updates, units, fingerprint })
     }
 
-    /// What makes unit `u`'s order ([`OrderMemo`]): how its scene is opened and its method.
+    /// What makes unit `u`'s order ([`RunMemo`]): how its scene is opened and its method.
     fn key(&self, spec: &Spec, opts: &RunOptions, u: usize) -> Result<String> {
         let work = spec.workload(opts.quick)?;
         let unit = &self.units[u];
@@ -178,6 +233,21 @@ impl<'a> Plan<'a> {
             spec.measure_options(work).per_draw_call,
             self.methods[unit.method].canonical()
         ))
+    }
+
+    /// What names model `m`'s views' layers when they are drawn on the CPU ([`RunMemo`]): how its
+    /// scene is opened, and the view set, its seed and the image size; `None` without views or
+    /// on another backend.
+    fn view_key(&self, spec: &Spec, opts: &RunOptions, m: usize) -> Result<Option<String>> {
+        let work = spec.workload(opts.quick)?;
+        let options = spec.measure_options(work);
+        let backend = opts.backend.as_deref().unwrap_or(&spec.backend);
+        Ok(options.views.filter(|_| backend == "cpu").map(|views| {
+            format!(
+                "{:?} seed {} levels {:?} per draw call {} · {views:?} seed {} at {}²",
+                self.models[m].source, spec.seed, work.levels, options.per_draw_call, options.seed, options.res
+            )
+        }))
     }
 
     /// The units `shard` does: those [`shard::assign`] gives it by estimated cost.
@@ -207,7 +277,7 @@ fn recorded(e: &Error) -> bool {
 }
 
 /// Runs a loaded spec, showing its progress bar among `bars`.
-pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut OrderMemo) -> Result<Outcome> {
+pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut RunMemo) -> Result<Outcome> {
     let work = spec.workload(opts.quick)?;
     let data = source::data_dir(opts.data.as_deref());
     let plan = Plan::new(spec, opts)?;
@@ -304,10 +374,15 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
             bar.set_message(format!("{}: measuring {} orders", model.name, ordered.len()));
             let orders: Vec<&Orders> = ordered.iter().map(|(_, e)| &e.orders).collect();
             // Measured together, or where that fails, one by one, so a failure is the method's.
-            let together = measure::measure_many(&scene, &orders, &options, raster.as_ref());
-            let together: Vec<Result<_>> = together.map(|m| m.into_iter().map(Ok).collect()).unwrap_or_else(|_| {
-                orders.iter().map(|o| measure::measure(&scene, o, &options, raster.as_ref())).collect()
-            });
+            let kept = memo.kept_layers(&spec.id, plan.view_key(spec, opts, m)?);
+            let raster: &dyn RasterBackend = match &kept {
+                Some(kept) if raster.name() == "cpu" => kept,
+                _ => raster.as_ref(),
+            };
+            let together = measure::measure_many(&scene, &orders, &options, raster);
+            let together: Vec<Result<_>> = together
+                .map(|m| m.into_iter().map(Ok).collect())
+                .unwrap_or_else(|_| orders.iter().map(|o| measure::measure(&scene, o, &options, raster)).collect());
             for ((u, mut evaluation), measured) in ordered.into_iter().zip(together) {
                 let method = &plan.methods[plan.units[u].method];
                 let result = measured.and_then(|measured| {
@@ -329,6 +404,9 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
                 }
                 bar.inc(1);
             }
+        }
+        if let Some(key) = plan.view_key(spec, opts, m)? {
+            memo.measured(&spec.id, &key);
         }
         if failures.len() > failed {
             bar.set_prefix(format!(
@@ -526,10 +604,10 @@ mod tests {
     /// nothing else; once they have run it is gone.
     #[test]
     fn a_memo_keeps_an_order_only_for_the_later_specs_that_ask_for_it() {
-        let claims = HashSet::from(["a".to_string(), "b".to_string()]);
-        let mut memo = OrderMemo { wanted: HashMap::from([("k".to_string(), claims)]), kept: HashMap::new() };
+        let claims = [("k", "a"), ("k", "b"), ("alone", "a")].map(|(k, s)| (k.to_string(), s.to_string()));
+        let mut memo = RunMemo { orders: Claims::of(claims), ..RunMemo::default() };
         let mut computed = 0;
-        let mut order = |memo: &mut OrderMemo, spec: &str, key: &str, seconds: f64| {
+        let mut order = |memo: &mut RunMemo, spec: &str, key: &str, seconds: f64| {
             memo.order(spec, key.to_string(), || {
                 computed += 1;
                 Ok(evaluation(seconds))
@@ -543,7 +621,39 @@ mod tests {
         memo.finished("a");
         assert_eq!(order(&mut memo, "b", "k", 3.0), 1.0);
         memo.finished("b");
-        assert!(memo.kept.is_empty() && memo.wanted.is_empty());
+        assert!(memo.kept.is_empty() && !memo.orders.contains("k"));
         assert_eq!(computed, 2);
+    }
+
+    /// Views' layers are kept under a key while a later spec asks for it: the first spec's
+    /// measurement keeps them, the last one's reads them without keeping more, a key one spec
+    /// alone asks for gets the plain backend.
+    #[test]
+    fn a_memo_keeps_layers_only_while_a_later_spec_asks_for_them() {
+        let claims = [("v", "a"), ("v", "b"), ("w", "a")].map(|(k, s)| (k.to_string(), s.to_string()));
+        let mut memo = RunMemo { views: Claims::of(claims), ..RunMemo::default() };
+        assert!(memo.kept_layers("a", Some("w".into())).is_none());
+        assert!(memo.kept_layers("a", None).is_none());
+        let mesh = crate::mesh::procedural::generate("sphere:500", 0).unwrap().unwrap();
+        let cameras = views::ViewSet::Ico(12).cameras(crate::mesh::Framing::of(&mesh.positions), 0);
+        let order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+        let (orders, picks) = (vec![&order[..]], vec![vec![0]; cameras.len()]);
+        let draws = crate::raster::OrderPicks { triangles: &mesh.triangles, orders: &orders, picks: &picks };
+        let measure = |kept: KeptLayers| kept.count_orders(&mesh.positions, &cameras, &draws, 32).unwrap();
+        let kept = memo.kept_layers("a", Some("v".into())).unwrap();
+        assert!(kept.keep && kept.tag == "v");
+        measure(kept);
+        memo.measured("a", "v");
+        let held = memo.layers.bytes();
+        assert!(held > 0, "kept for b");
+        memo.finished("a");
+        let kept = memo.kept_layers("b", Some("v".into())).unwrap();
+        assert!(!kept.keep);
+        measure(kept);
+        assert_eq!(memo.layers.bytes(), held, "b reads what a kept");
+        memo.measured("b", "v");
+        assert_eq!(memo.layers.bytes(), 0, "dropped once the last spec that asks has measured");
+        memo.finished("b");
+        assert!(memo.kept_layers("b", Some("v".into())).is_none());
     }
 }

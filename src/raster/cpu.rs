@@ -74,36 +74,58 @@ impl RasterBackend for CpuRaster {
         draws: &OrderPicks,
         res: u32,
     ) -> Result<Vec<Vec<ViewCounts>>> {
-        let (triangles, orders, picks) = (draws.triangles, draws.orders, draws.picks);
-        // A replay is only the same count for a permutation of every triangle.
-        if orders.iter().any(|o| o.len() != triangles.len()) {
+        let Some(replay) = Replay::new(draws) else {
             return super::count_each_order(self, positions, cameras, draws, res);
+        };
+        let local = Local::of(positions, draws.triangles);
+        let counted = each_view(&local.positions, cameras, res, LayerScratch::default, |scratch, screen, v| {
+            replay.counts(&scratch.layers(screen, &local, res), &draws.picks[v])
+        });
+        named_as_given(counted, positions, cameras, res)
+    }
+}
+
+/// The orders of an [`OrderPicks`] ready to be replayed on any view's [`DepthLayers`]: the orders
+/// every view draws (every static method's) side by side ([`LaneRanks`]), the others
+/// (view-dependent methods' buffers) one by one.
+pub(crate) struct Replay {
+    /// The orders every view draws, ascending: lane `i` replays `everywhere[i]`.
+    everywhere: Vec<usize>,
+    lanes: LaneRanks,
+    /// Per order, its ranks, for the others only (empty for those replayed side by side).
+    ranks: Vec<Vec<u32>>,
+}
+
+impl Replay {
+    /// `None` unless every order is a permutation of every triangle: only then is a replay the
+    /// same count as a draw.
+    pub(crate) fn new(draws: &OrderPicks) -> Option<Replay> {
+        let (orders, picks) = (draws.orders, draws.picks);
+        if orders.iter().any(|o| o.len() != draws.triangles.len()) {
+            return None;
         }
-        // The orders every view draws (every static method's) are replayed side by side
-        // ([`LaneRanks`]); the others (view-dependent methods' buffers) one by one.
         let mut everywhere: Vec<usize> = picks.first().cloned().unwrap_or_default();
         everywhere.sort_unstable();
         everywhere.dedup();
         everywhere.retain(|o| picks.iter().all(|p| p.contains(o)));
         let lanes = LaneRanks::new(&everywhere.iter().map(|&o| orders[o]).collect::<Vec<_>>());
-        // Ranks one by one for the others only (empty for those replayed side by side).
-        let ranks: Vec<Vec<u32>> = (0..orders.len())
+        let ranks = (0..orders.len())
             .into_par_iter()
             .map(|o| if everywhere.binary_search(&o).is_ok() { Vec::new() } else { layers::ranks(orders[o]) })
             .collect();
-        let local = Local::of(positions, triangles);
-        let counted = each_view(&local.positions, cameras, res, LayerScratch::default, |scratch, screen, v| {
-            let layers = scratch.layers(screen, &local, res);
-            let side_by_side = layers.counts_all(&lanes);
-            picks[v]
-                .iter()
-                .map(|&o| match everywhere.binary_search(&o) {
-                    Ok(lane) => side_by_side[lane],
-                    Err(_) => layers.counts(&ranks[o]),
-                })
-                .collect()
-        });
-        named_as_given(counted, positions, cameras, res)
+        Some(Replay { everywhere, lanes, ranks })
+    }
+
+    /// The counts of the orders `picks` (indices into the orders) on one view's layers.
+    pub(crate) fn counts(&self, layers: &DepthLayers, picks: &[usize]) -> Vec<ViewCounts> {
+        let side_by_side = layers.counts_all(&self.lanes);
+        picks
+            .iter()
+            .map(|&o| match self.everywhere.binary_search(&o) {
+                Ok(lane) => side_by_side[lane],
+                Err(_) => layers.counts(&self.ranks[o]),
+            })
+            .collect()
     }
 }
 

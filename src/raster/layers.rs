@@ -35,6 +35,11 @@ pub struct DepthLayers {
 const TIED: u32 = 1 << 31;
 
 impl DepthLayers {
+    /// The memory the layers hold, in bytes.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<DepthLayers>() + 4 * (self.triangles.capacity() + self.starts.capacity())
+    }
+
     /// Groups `fragments` (of an image `res` pixels square) by pixel, a counting sort over the
     /// run of pixels they reach with scratch in `slots`, and keeps the contested pixels, each
     /// sorted by depth. Fragments at depth 1.0 or beyond (or NaN) can never pass and are left

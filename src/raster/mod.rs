@@ -2,6 +2,7 @@
 //! backend), returning the same per-view counts under the same rules so they can be cross-checked.
 
 pub mod cpu;
+pub mod kept;
 pub mod layers;
 pub mod views;
 
