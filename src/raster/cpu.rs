@@ -119,11 +119,14 @@ impl Replay {
     /// The counts of the orders `picks` (indices into the orders) on one view's layers.
     pub(crate) fn counts(&self, layers: &DepthLayers, picks: &[usize]) -> Vec<ViewCounts> {
         let side_by_side = layers.counts_all(&self.lanes);
+        let others: Vec<&[u32]> =
+            picks.iter().filter(|o| self.everywhere.binary_search(o).is_err()).map(|&o| &self.ranks[o][..]).collect();
+        let mut others = layers.counts_each(&others).into_iter();
         picks
             .iter()
             .map(|&o| match self.everywhere.binary_search(&o) {
                 Ok(lane) => side_by_side[lane],
-                Err(_) => layers.counts(&self.ranks[o]),
+                Err(_) => others.next().expect("one count for each other order"),
             })
             .collect()
     }

@@ -112,25 +112,49 @@ impl DepthLayers {
         passed
     }
 
-    /// [`DepthLayers::replay`] of one chunk of [`LaneRanks`], in AVX2 where the processor has it.
-    /// The scan's work per fragment is an unsigned minimum and compare of eight lanes: one
+    /// [`DepthLayers::counts`] of each order of `ranks` (each order's plain ranks, [`ranks`]):
+    /// [`LANES`] orders a scan, a triangle's rank in each gathered from its own array. For the
+    /// view-dependent buffers a view picks (one per hs17 method, say), which no [`LaneRanks`]
+    /// holds side by side: scanned one by one, each read every entry and took its branch.
+    pub fn counts_each(&self, ranks: &[&[u32]]) -> Vec<ViewCounts> {
+        let mut passed = Vec::with_capacity(ranks.len());
+        for chunk in ranks.chunks(LANES) {
+            match chunk {
+                [one] => passed.push(self.contested_passes(one)),
+                _ => {
+                    let last = chunk.len() - 1;
+                    let lanes = self.replay_wide(|t| std::array::from_fn(|l| chunk[l.min(last)][t]));
+                    passed.extend_from_slice(&lanes[..chunk.len()]);
+                }
+            }
+        }
+        passed.into_iter().map(|p| self.with_contested(p)).collect()
+    }
+
+    /// [`DepthLayers::replay`] of one chunk of [`LaneRanks`].
+    fn replay_lanes(&self, lanes: &[[u32; LANES]]) -> [u32; LANES] {
+        self.replay_wide(|t| lanes[t])
+    }
+
+    /// [`DepthLayers::replay`] of [`LANES`] orders, in AVX2 where the processor has it. The
+    /// scan's work per fragment is an unsigned minimum and compare of eight lanes: one
     /// instruction each in AVX2, a dozen in the SSE2 that baseline x86-64 compiles to (it has no
     /// unsigned compare, so every lane's sign is flipped first), where the scan was a sixth of a
     /// full `reproduce`. Integer operations either way, so the counts are the same.
-    fn replay_lanes(&self, lanes: &[[u32; LANES]]) -> [u32; LANES] {
+    fn replay_wide(&self, rank: impl Fn(usize) -> [u32; LANES]) -> [u32; LANES] {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has AVX2, checked just above.
-            return unsafe { self.replay_avx2(lanes) };
+            return unsafe { self.replay_avx2(rank) };
         }
-        self.replay(|t| lanes[t])
+        self.replay(rank)
     }
 
-    /// [`DepthLayers::replay`] of one chunk compiled for AVX2 (the scan is inlined here).
+    /// [`DepthLayers::replay`] of [`LANES`] orders compiled for AVX2 (the scan is inlined here).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn replay_avx2(&self, lanes: &[[u32; LANES]]) -> [u32; LANES] {
-        self.replay(|t| lanes[t])
+    fn replay_avx2(&self, rank: impl Fn(usize) -> [u32; LANES]) -> [u32; LANES] {
+        self.replay(rank)
     }
 
     /// The depth test of `L` orders over the contested pixels, `rank(t)` giving triangle t's rank
@@ -291,12 +315,18 @@ mod tests {
         let portable: Vec<u32> = lanes.chunks.iter().flat_map(|c| layers.replay(|t| c[t])).collect();
         let dispatched: Vec<u32> = lanes.chunks.iter().flat_map(|c| layers.replay_lanes(c)).collect();
         assert_eq!(dispatched, portable);
-        let one_by_one: Vec<u32> = orders.iter().map(|o| layers.contested_passes(&ranks(o))).collect();
+        let plain: Vec<Vec<u32>> = orders.iter().map(|o| ranks(o)).collect();
+        let one_by_one: Vec<u32> = plain.iter().map(|r| layers.contested_passes(r)).collect();
         assert_eq!(layers.contested_passes_all(&lanes), one_by_one);
+        // Gathered from plain ranks, in chunks of eight, three and one.
+        let plain: Vec<&[u32]> = plain.iter().map(|r| &r[..]).collect();
+        let each: Vec<ViewCounts> = one_by_one.iter().map(|&p| layers.with_contested(p)).collect();
+        assert_eq!(layers.counts_each(&plain), each);
+        assert_eq!(layers.counts_each(&plain[..1]), each[..1]);
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: checked just above.
-            let avx2: Vec<u32> = lanes.chunks.iter().flat_map(|c| unsafe { layers.replay_avx2(c) }).collect();
+            let avx2: Vec<u32> = lanes.chunks.iter().flat_map(|c| unsafe { layers.replay_avx2(|t| c[t]) }).collect();
             assert_eq!(avx2, portable);
         }
     }
