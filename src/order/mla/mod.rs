@@ -345,6 +345,10 @@ struct Window {
     inside: Vec<Vec<(usize, u64)>>,
     nodes: Vec<u32>,
     best_perm: Vec<u32>,
+    /// Per window node and set of window nodes placed before it (a bitmask, which fixes where it
+    /// lies): the cost of its outside edges there, `u64::MAX` until counted. The search meets
+    /// each (node, set) once per order of the set, so it counted the same sums up to six times.
+    outside_at: [[u64; 1 << WINDOW]; WINDOW],
 }
 
 impl Window {
@@ -371,6 +375,9 @@ impl Window {
                 }
             }
         }
+        for row in &mut self.outside_at[..k] {
+            row.fill(u64::MAX);
+        }
         // The current order's cost, then the best over all orders by branch and bound.
         let mut place = [0i64; WINDOW];
         let mut current = 0u64;
@@ -378,7 +385,7 @@ impl Window {
         for i in 0..k {
             place[i] = 2 * start + self.vol[i];
             start += self.vol[i];
-            current += self.outside[i].iter().map(|&(xv, w)| w * place[i].abs_diff(xv)).sum::<u64>();
+            current += self.outside_cost(i, (1 << i) - 1, place[i]);
             current += self.inside[i]
                 .iter()
                 .filter(|&&(j, _)| j < i)
@@ -399,11 +406,21 @@ impl Window {
         }
     }
 
+    /// The cost of window node `i`'s outside edges with the nodes of `used` placed before it,
+    /// its centre then at `x` ([`Window::outside_at`]).
+    fn outside_cost(&mut self, i: usize, used: u32, x: i64) -> u64 {
+        let slot = &mut self.outside_at[i][used as usize];
+        if *slot == u64::MAX {
+            *slot = self.outside[i].iter().map(|&(xv, w)| w * x.abs_diff(xv)).sum();
+        }
+        *slot
+    }
+
     /// Depth-first over orders: `depth` nodes placed (those in `used`), volume `start` so far,
     /// partial cost `cost`; `place[i]` is node i's centre once placed.
     #[allow(clippy::too_many_arguments)]
     fn search(
-        &self,
+        &mut self,
         depth: usize,
         used: u32,
         start: i64,
@@ -426,7 +443,7 @@ impl Window {
                 continue;
             }
             let xi = 2 * start + self.vol[i];
-            let mut c = cost + self.outside[i].iter().map(|&(xv, w)| w * xi.abs_diff(xv)).sum::<u64>();
+            let mut c = cost + self.outside_cost(i, used, xi);
             c += self.inside[i]
                 .iter()
                 .filter(|&&(j, _)| used & (1 << j) != 0)
