@@ -356,6 +356,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
         let mut scene = scene;
         // The methods of one update are ordered one by one, then measured together, so that the
         // work every order shares (each view rasterized once for overdraw) is done once.
+        let view_key = plan.view_key(spec, opts, m)?;
         for batch in todo.chunk_by(|&a, &b| plan.units[a].update == plan.units[b].update) {
             scene.set_update(plan.updates[plan.units[batch[0]].update]);
             let mut ordered: Vec<(usize, Evaluation)> = Vec::new();
@@ -374,7 +375,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
             bar.set_message(format!("{}: measuring {} orders", model.name, ordered.len()));
             let orders: Vec<&Orders> = ordered.iter().map(|(_, e)| &e.orders).collect();
             // Measured together, or where that fails, one by one, so a failure is the method's.
-            let kept = memo.kept_layers(&spec.id, plan.view_key(spec, opts, m)?);
+            let kept = memo.kept_layers(&spec.id, view_key.clone());
             let raster: &dyn RasterBackend = match &kept {
                 Some(kept) if raster.name() == "cpu" => kept,
                 _ => raster.as_ref(),
@@ -405,8 +406,8 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
                 bar.inc(1);
             }
         }
-        if let Some(key) = plan.view_key(spec, opts, m)? {
-            memo.measured(&spec.id, &key);
+        if let Some(key) = &view_key {
+            memo.measured(&spec.id, key);
         }
         if failures.len() > failed {
             bar.set_prefix(format!(
