@@ -87,7 +87,8 @@ impl RasterBackend for CpuRaster {
 
 /// The orders of an [`OrderPicks`] ready to be replayed on any view's [`DepthLayers`]: the orders
 /// every view draws (every static method's) side by side ([`LaneRanks`]), the others
-/// (view-dependent methods' buffers) one by one.
+/// (view-dependent methods' buffers) gathered from their own ranks, eight to a scan
+/// ([`DepthLayers::counts_each`]).
 pub(crate) struct Replay {
     /// The orders every view draws, ascending: lane `i` replays `everywhere[i]`.
     everywhere: Vec<usize>,
