@@ -427,12 +427,13 @@ impl<'a> State<'a> {
         //
         // Unchecked, and a row's chunks copied by a plain loop (the compiler unrolled the range
         // four times, for rows that are mostly one chunk): 15% fewer instructions for the whole
-        // order of RiggedSimple's 188 triangles (callgrind). In bounds because every listed vertex is a triangle's corner (checked
-        // to be a vertex by `State::new`), every place is below `cache + 3` (corners take 0..3;
-        // an older entry, below `cache`, moves back by at most 3), a chunk starts before its
-        // row's end (or at the start of an empty row) and `adjacent` is padded by a chunk, and
-        // `count` sums the live counts of distinct vertices, at most 3 × the triangles and at
-        // most `cache + 3` of the longest row, with a chunk of room past that.
+        // order of RiggedSimple's 188 triangles (callgrind). In bounds because every listed
+        // vertex is a triangle's corner (checked to be a vertex by `State::new`), every place is
+        // below `cache + 3` (corners take 0..3; an older entry, below `cache`, moves back by at
+        // most 3), a chunk starts before its row's end (or at the start of an empty row) and
+        // `adjacent` is padded by a chunk, and `count` sums the live counts of distinct
+        // vertices, at most 3 × the triangles and at most `cache + 3` of the longest row, with a
+        // chunk of room past that.
         let mut count = 0;
         for &Entry { vertex, place } in &next[..len] {
             debug_assert!((vertex as usize) < vertices.len() && (place as usize) < place_score.len());
