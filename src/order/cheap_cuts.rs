@@ -43,7 +43,7 @@
 //! bench` (median of 11, AMD EPYC, the views on both threads) it is 2.4–3× meshopt-overdraw's
 //! on six of the large models, 3.1–7× on the other meshes over 4k triangles, and 20–100× on the
 //! small characters, where the raster's per-view cost does not shrink with the mesh. A mesh no
-//! cut fits (RiggedSimple) is one piece, returned without drawing views: 1.35×.
+//! cut fits (RiggedSimple) is one piece, returned without drawing views: 1.2–1.35×.
 
 use std::collections::BTreeSet;
 
