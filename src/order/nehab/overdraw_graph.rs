@@ -27,7 +27,7 @@
 //! the two agree exactly.
 //!
 //! Memory: one n×n matrix of u64 per worker thread, plus the layers of the views being counted:
-//! [`one_pass`] rasterizes 16 views at a time.
+//! [`one_pass`] rasterizes as many views at a time as a budget of pixels allows (`views_at_once`).
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -111,6 +111,11 @@ impl OverdrawGraph {
 /// The graph from one rasterization per camera: each view's fragments as [`DepthLayers`] (a few
 /// views at a time, in parallel), then [`from_layers`].
 pub fn one_pass(draw: ClusteredDraw, cameras: &[Camera], res: u32) -> Result<OverdrawGraph> {
+    in_batches(draw, cameras, res, views_at_once(res))
+}
+
+/// [`one_pass`] with the layers of `batch` views held at once.
+fn in_batches(draw: ClusteredDraw, cameras: &[Camera], res: u32, batch: usize) -> Result<OverdrawGraph> {
     let n = draw.cluster_count();
     let mut cluster_of = vec![0u32; draw.triangles.len()];
     for c in 0..n {
@@ -119,16 +124,25 @@ pub fn one_pass(draw: ClusteredDraw, cameras: &[Camera], res: u32) -> Result<Ove
     // The triangles are listed in draw order.
     let rank: Vec<u32> = (0..draw.triangles.len() as u32).collect();
     let mut graph = OverdrawGraph::zero(n);
-    for views in cameras.chunks(VIEWS_AT_ONCE) {
+    for views in cameras.chunks(batch) {
         let layers = depth_layers(draw.positions, draw.triangles, views, res)?;
         graph = graph.add(from_layers(&layers, &rank, &cluster_of, n));
     }
     Ok(graph)
 }
 
-/// Views whose layers [`one_pass`] holds at once: enough to keep both threads busy, few enough
-/// that memory does not grow with the view set.
-const VIEWS_AT_ONCE: usize = 16;
+/// How many views' layers [`one_pass`] holds at once: as many as [`PIXELS_AT_ONCE`] pixels
+/// allow, so that memory does not grow with the view set, and at least one per thread. Sized by
+/// pixels rather than views: small views in one batch share one renumbering of the mesh and one
+/// start of the threads (cheap-cuts' 42 views at 64² are one batch, not three).
+fn views_at_once(res: u32) -> usize {
+    let pixels = (res as usize * res as usize).max(1);
+    (PIXELS_AT_ONCE / pixels).max(rayon::current_num_threads())
+}
+
+/// The pixels of sixteen views at 512²: the batch [`one_pass`] held at every resolution before it
+/// was sized by pixels.
+const PIXELS_AT_ONCE: usize = 16 * 512 * 512;
 
 /// The graph of `n` clusters (`cluster_of[t]`: triangle t's) drawn in the order `rank` (`rank[t]`:
 /// triangle t's place), from views of those triangles already rasterized ([`DepthLayers`], views
@@ -236,4 +250,26 @@ pub fn pair_by_pair(draw: ClusteredDraw, cameras: &[Camera], res: u32) -> Result
         }
     }
     Ok(graph)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Framing, procedural};
+    use crate::raster::ViewSet;
+
+    /// The graph is a sum over views, so how many views are drawn at once changes nothing: one
+    /// batch (what 42 views at 64² now are) and batches of five give the same counts.
+    #[test]
+    fn batching_the_views_changes_no_count() {
+        let mesh = procedural::generate("helix:3", 1).unwrap().unwrap();
+        let starts: Vec<usize> = (0..=6).map(|i| i * mesh.triangle_count() / 6).collect();
+        let draw = ClusteredDraw { positions: &mesh.positions, triangles: &mesh.triangles, starts: &starts };
+        let cameras = ViewSet::Ico(42).cameras(Framing::of(&mesh.positions), 0);
+        assert!(views_at_once(64) >= cameras.len(), "42 views at 64² are one batch");
+        let whole = one_pass(draw, &cameras, 64).unwrap();
+        let fives = in_batches(draw, &cameras, 64, 5).unwrap();
+        assert!(!whole.arcs().is_empty());
+        assert_eq!(whole.saved, fives.saved);
+    }
 }
