@@ -269,6 +269,11 @@ enum Command {
         /// Raster backend for overdraw in every spec: cpu or gpu (Vulkan through wgpu).
         #[arg(long, value_name = "cpu|gpu")]
         backend: Option<String>,
+        /// Skip the specs that need a GPU even where there is one: with only Mesa's software
+        /// rasterizer (lavapipe) they time the CPU emulating a GPU, and the frame-time specs alone
+        /// take minutes.
+        #[arg(long, conflicts_with = "backend")]
+        cpu_only: bool,
     },
     /// Time our metrics and orderings against meshoptimizer (the meshopt crate) in the same run.
     Bench {
@@ -306,7 +311,9 @@ fn main() -> ExitCode {
         Command::Merge { spec, quick, shards } => commands::merge(&spec, quick, shards, common),
         Command::Plot { spec, quick } => commands::plot(&spec, quick, common),
         Command::Gallery { check, file } => commands::gallery(&file, check),
-        Command::Reproduce { quick, only, backend } => commands::reproduce(quick, only.as_deref(), backend, common),
+        Command::Reproduce { quick, only, backend, cpu_only } => {
+            commands::reproduce(quick, only.as_deref(), backend, cpu_only, common)
+        }
         Command::Bench { reps, meshes, only } => commands::bench(reps, &meshes, only, common),
     };
     match result {

@@ -54,8 +54,9 @@ pub struct Outcome {
 /// file-name order. Every spec is loaded and checked before the first one runs, so a typo in the
 /// last spec does not surface after an hour of work. Specs that ask for the GPU themselves are
 /// skipped, with the reason, where there is none, so every CPU experiment still runs on any
-/// machine (an explicit `--backend gpu` must work).
-pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
+/// machine (an explicit `--backend gpu` must work); with `cpu_only` they are skipped wherever
+/// they are, and no GPU is opened.
+pub fn reproduce(opts: &RunOptions, filter: Option<&str>, cpu_only: bool) -> Result<Outcome> {
     let start = Instant::now();
     let dir = opts.out_dir.join("experiments");
     let entries =
@@ -76,7 +77,11 @@ pub fn reproduce(opts: &RunOptions, filter: Option<&str>) -> Result<Outcome> {
     }
     let specs = paths.iter().map(|p| Spec::load(p)).collect::<Result<Vec<_>>>()?;
     let gpu = |spec: &Spec| opts.backend.is_none() && spec.needs_gpu();
-    let device = if specs.iter().any(gpu) { Some(crate::gpu::shared().map(describe)) } else { None };
+    let device = match specs.iter().any(gpu) {
+        false => None,
+        true if cpu_only => Some(Err("--cpu-only: none opened".to_string())),
+        true => Some(crate::gpu::shared().map(describe).map_err(|e| e.to_string())),
+    };
     let bars = bars(opts.progress);
     let overall = bars.add(ProgressBar::new(specs.len() as u64));
     overall.set_style(style("experiments {pos}/{len} {bar:30} {msg}"));

@@ -235,6 +235,25 @@ fn gpu_backend_without_a_driver_says_how_to_get_one() {
     );
 }
 
+/// `--cpu-only` skips the specs that need a GPU whether or not one is there (lavapipe is on CI),
+/// and says so.
+#[test]
+fn cpu_only_skips_the_gpu_specs_wherever_a_gpu_is() {
+    let o = Command::new(env!("CARGO_BIN_EXE_triorder"))
+        .args(["reproduce", "--quick", "--only", "hw-vertex-reuse", "--cpu-only"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let (out, err) = (stdout(&o), stderr(&o));
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(!out.contains("wrote") && !out.contains("GPU specs ran on"), "{out}");
+    assert!(
+        out.contains("reproduced 0 of 1 specs") && out.contains("skipped hw-vertex-reuse: it needs a GPU (--cpu-only"),
+        "{out}"
+    );
+    assert!(fails(&["reproduce", "--quick", "--cpu-only", "--backend", "gpu"]).contains("--backend"));
+}
+
 #[test]
 fn every_broken_file_fails_cleanly() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");

@@ -443,12 +443,12 @@ fn reproduce_runs_and_plots_every_matching_spec_in_order() {
     let root = tempfile::tempdir().unwrap();
     common::write_spec(root.path(), "tiny", TINY);
     common::write_spec(root.path(), "another", &TINY.replace("id = \"tiny\"", "id = \"another\""));
-    let outputs = reproduce(&quick(root.path()), None).unwrap().ran;
+    let outputs = reproduce(&quick(root.path()), None, false).unwrap().ran;
     let ids: Vec<_> = outputs.iter().map(|ran| ran.csv.file_stem().unwrap().to_string_lossy().into_owned()).collect();
     assert_eq!(ids, ["another", "tiny"]);
     assert!(outputs.iter().all(|ran| ran.csv.is_file() && ran.svg.is_file() && ran.seconds > 0.0));
-    assert_eq!(reproduce(&quick(root.path()), Some("tin")).unwrap().ran.len(), 1);
-    let err = reproduce(&quick(root.path()), Some("nothing")).unwrap_err().to_string();
+    assert_eq!(reproduce(&quick(root.path()), Some("tin"), false).unwrap().ran.len(), 1);
+    let err = reproduce(&quick(root.path()), Some("nothing"), false).unwrap_err().to_string();
     assert!(err.contains("matching `nothing`"), "{err}");
     // A broken spec stops everything before any run.
     common::write_spec(
@@ -457,7 +457,7 @@ fn reproduce_runs_and_plots_every_matching_spec_in_order() {
         &TINY.replace("id = \"tiny\"", "id = \"broken\"").replace("\"input\"", "\"nope\""),
     );
     std::fs::remove_dir_all(root.path().join("results")).unwrap();
-    assert!(reproduce(&quick(root.path()), None).unwrap_err().to_string().contains("broken.toml"));
+    assert!(reproduce(&quick(root.path()), None, false).unwrap_err().to_string().contains("broken.toml"));
     assert!(!root.path().join("results").exists());
 }
 

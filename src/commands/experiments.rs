@@ -97,8 +97,14 @@ pub fn gallery(file: &Path, check: bool) -> Result<()> {
     Ok(())
 }
 
-pub fn reproduce(quick: bool, only: Option<&str>, backend: Option<String>, common: &Common) -> Result<()> {
-    let outcome = reproduce::reproduce(&run_options(quick, backend, common)?, only)?;
+pub fn reproduce(
+    quick: bool,
+    only: Option<&str>,
+    backend: Option<String>,
+    cpu_only: bool,
+    common: &Common,
+) -> Result<()> {
+    let outcome = reproduce::reproduce(&run_options(quick, backend, common)?, only, cpu_only)?;
     for ran in &outcome.ran {
         println!("wrote {} and {} ({:.1} s)", ran.csv.display(), ran.svg.display(), ran.seconds);
     }
