@@ -9,8 +9,8 @@
 //!
 //! `TRIORDER_REQUIRE_DATA` and `TRIORDER_REQUIRE_GPU` (CI sets both) turn the cfg on regardless,
 //! so a missing directory or driver fails the tests with a clear message instead. Cargo reruns
-//! this when one of these variables changes; after fetching the models into a new directory, set
-//! `TRIORDER_DATA` to it.
+//! this when one of these variables changes or a driver manifest is added; after fetching the
+//! models into a new directory, set `TRIORDER_DATA` to it.
 
 use std::path::PathBuf;
 
@@ -32,7 +32,16 @@ fn main() {
         println!("cargo::rustc-cfg=triorder_data");
     }
     let named = ["VK_DRIVER_FILES", "VK_ICD_FILENAMES"].iter().any(|v| set(v));
-    let manifests = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d"]
+    let icd_dirs = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d"];
+    // Rerun when a driver is installed after the first build, which would otherwise leave the GPU
+    // tests ignored as if there were none: watch each manifest directory, or the `vulkan`
+    // directory it would be made in (small, unlike its parent, which Cargo would scan whole).
+    for dir in icd_dirs.map(PathBuf::from) {
+        if let Some(watched) = [dir.as_path(), dir.parent().unwrap_or(&dir)].into_iter().find(|d| d.is_dir()) {
+            println!("cargo::rerun-if-changed={}", watched.display());
+        }
+    }
+    let manifests = icd_dirs
         .iter()
         .filter_map(|dir| std::fs::read_dir(dir).ok())
         .flatten()
