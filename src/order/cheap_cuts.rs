@@ -26,6 +26,11 @@
 //! 4. **Pieces ordered** by the pairwise overdraw graph of Nehab, Barczak & Sander 2006 (§4,
 //!    computed exactly in one raster pass per view, [`one_pass`]) over `views` icosahedral views at
 //!    `res`², then the greedy feedback arc set (§5). Each piece keeps its cache order inside.
+//! 5. **Successions kept** ([`keep_successions`]): pieces that follow each other in the cache
+//!    order are drawn together again wherever that puts no more arc weight backward, so those
+//!    cuts cost no cache hits after all. Added after the tuning below, with no parameter of its
+//!    own: on the five tuning models it lowered every measure (mean OVR by 0.0015–0.0074,
+//!    FIFO-16 by 0.25–0.34%, Intel's FIFO 128 by 1.0–1.7%, NVIDIA and AMD by 0.2–0.5%).
 //!
 //! **Tuning, and what it costs.** The defaults were chosen on five models only: bun_zipper,
 //! dragon_vrip_res3, feline, horse and rocker-arm (the rest are held out; spot and
@@ -34,24 +39,26 @@
 //! the NVIDIA and AMD models within 2% of the best ordering; what was tried and dropped: 12 views
 //! or 16–24 random ones (OVR up to 0.01 worse), a graph drawn from every second or third
 //! triangle (worse), cuts priced by hits alone (worse on all five). What the cuts cannot keep
-//! is Intel's FIFO 128, where a cut costs up to 128 hits: the defaults land 3–6% above the best
-//! ordering there (still 2–9% below meshopt-overdraw), and holding it within 2% with `far` costs
-//! the overdraw that beats meshopt-overdraw: the trade-off `experiments/cheap-cuts-intel-tradeoff.toml`
-//! sweeps. Held out, one of the two main targets fails on six of eleven models: by up to 0.007
-//! OVR on welded meshes (more on the two unwelded characters, where no cache order helps) or 1.6%
-//! ACMR (paper-figures/README.md has the table). Time: the 42 small views dominate. By `triorder
+//! is Intel's FIFO 128, where a cut costs up to 128 hits: the defaults landed 3–6% above the best
+//! ordering there before step 5 (still 2–9% below meshopt-overdraw), and holding it within 2%
+//! with `far` costs the overdraw that beats meshopt-overdraw: the trade-off
+//! `experiments/cheap-cuts-intel-tradeoff.toml` sweeps. Held out, one of the two main targets
+//! fails on four of eleven models with step 5 (six without): OVR on armadillo (1.049 against
+//! 1.048) and on the two unwelded characters, where no cache order helps, and FIFO-16 on spot
+//! (+1.4%) (paper-figures/README.md has the table). Time: the 42 small views dominate. By `triorder
 //! bench` (median of 11, AMD EPYC, the views on both threads) it is 2.4–3× meshopt-overdraw's
 //! on six of the large models, 3.1–7× on the other meshes over 4k triangles, and 20–100× on the
 //! small characters, where the raster's per-view cost does not shrink with the mesh. A mesh no
 //! cut fits (RiggedSimple) is one piece, returned without drawing views: 1.2–1.35×.
 
 use std::collections::BTreeSet;
+use std::ops::RangeInclusive;
 
 use glam::{DVec3, Vec3};
 
 use super::forsyth::{Scores, forsyth};
 use super::nehab::feedback_arc_set::greedy_order;
-use super::nehab::overdraw_graph::{ClusteredDraw, one_pass};
+use super::nehab::overdraw_graph::{Arc, ClusteredDraw, one_pass};
 use super::{Clustered, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::Result;
 use crate::mesh::{Framing, Scene};
@@ -173,8 +180,110 @@ impl Ordering for CheapCuts {
         let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &starts };
         let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
         let graph = one_pass(draw, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?;
-        let sequence = greedy_order(draw.cluster_count(), &graph.arcs());
+        let arcs = graph.arcs();
+        let sequence = keep_successions(greedy_order(draw.cluster_count(), &arcs), &arcs);
         Ok(Clustered::concat(sequence.iter().map(|&c| &order[starts[c as usize]..starts[c as usize + 1]])).into())
+    }
+}
+
+/// `sequence` (the pieces' order from the feedback arc set) with pieces that follow each other in
+/// the cache order put back together wherever that breaks no more of the graph's arcs.
+///
+/// A cut is priced as a cold start, but a piece drawn right after its predecessor in the cache
+/// order starts with that predecessor's vertices cached and loses nothing. The greedy order
+/// rarely keeps such successions even where no arc joins the two pieces (neighbours on the
+/// surface seldom overlap in a view): on the five tuning models it kept 3–7 of 63–277 while
+/// 17–249 of them had no arc. So, for each piece in cache order, the run of pieces already
+/// drawn together that it ends and the run its successor starts are joined, moving one run to
+/// the other (whichever move puts less arc weight backward; the successor's run on a tie), when
+/// the move puts no more weight backward than before; passes repeat until none moves. The
+/// arcs' backward weight, the overdraw the graph predicts, never grows.
+fn keep_successions(sequence: Vec<u32>, arcs: &[Arc]) -> Vec<u32> {
+    let pieces = sequence.len() as u32;
+    let mut joiner = Joiner::new(sequence, arcs);
+    // Every move joins a succession and breaks none (whole runs move), so this ends.
+    loop {
+        let mut moved = false;
+        for c in 0..pieces.saturating_sub(1) {
+            moved |= joiner.join(c);
+        }
+        if !moved {
+            return joiner.sequence;
+        }
+    }
+}
+
+/// The state of [`keep_successions`]: the sequence, each piece's place in it, and each piece's
+/// arcs, signed: positive where the arc wants this piece first.
+struct Joiner {
+    sequence: Vec<u32>,
+    position: Vec<usize>,
+    neighbours: Vec<Vec<(u32, i64)>>,
+}
+
+impl Joiner {
+    fn new(sequence: Vec<u32>, arcs: &[Arc]) -> Joiner {
+        let mut neighbours = vec![Vec::new(); sequence.len()];
+        for arc in arcs {
+            neighbours[arc.from as usize].push((arc.to, arc.weight as i64));
+            neighbours[arc.to as usize].push((arc.from, -(arc.weight as i64)));
+        }
+        let mut joiner = Joiner { position: vec![0; sequence.len()], sequence, neighbours };
+        joiner.place();
+        joiner
+    }
+
+    fn place(&mut self) {
+        for (i, &piece) in self.sequence.iter().enumerate() {
+            self.position[piece as usize] = i;
+        }
+    }
+
+    /// Whether the pieces at `i` and `i + 1` follow each other in the cache order.
+    fn succession(&self, i: usize) -> bool {
+        self.sequence[i + 1] == self.sequence[i] + 1
+    }
+
+    /// The change in backward weight when the pieces at `block` move to the other side of those
+    /// at `across`: every pair between the two flips; `later` when the block moves after them.
+    fn flip(&self, block: RangeInclusive<usize>, across: RangeInclusive<usize>, later: bool) -> i64 {
+        let flipped = block
+            .flat_map(|i| &self.neighbours[self.sequence[i] as usize])
+            .filter(|(other, _)| across.contains(&self.position[*other as usize]))
+            .map(|&(_, w)| w)
+            .sum::<i64>();
+        if later { flipped } else { -flipped }
+    }
+
+    /// Joins the run of pieces ending with `c` and the run starting with `c + 1`, if one of the
+    /// two moves to the other without putting more arc weight backward; whether it moved.
+    fn join(&mut self, c: u32) -> bool {
+        let (end, next) = (self.position[c as usize], self.position[c as usize + 1]);
+        if next == end + 1 {
+            return false;
+        }
+        let n = self.sequence.len();
+        // A = [a, end] (the run ending with c), B = [next, b] (the run starting with c + 1).
+        let a = (0..end).rev().take_while(|&i| self.succession(i)).last().unwrap_or(end);
+        let b = (next..n - 1).take_while(|&i| self.succession(i)).last().map_or(next, |i| i + 1);
+        let (change, block, to) = if next > end {
+            // A, gap, B: B moves back behind A, or A on before B, across the gap.
+            let (b_back, a_on) = (self.flip(next..=b, end + 1..=next - 1, false), self.flip(a..=end, end + 1..=next - 1, true));
+            if b_back <= a_on { (b_back, next..=b, end + 1) } else { (a_on, a..=end, next) }
+        } else {
+            // B, gap, A: B moves on behind A across the gap and A, or A back before B across B
+            // and the gap.
+            let (b_on, a_back) = (self.flip(next..=b, b + 1..=end, true), self.flip(a..=end, next..=a - 1, false));
+            if b_on <= a_back { (b_on, next..=b, end + 1) } else { (a_back, a..=end, next) }
+        };
+        if change > 0 {
+            return false;
+        }
+        let run: Vec<u32> = self.sequence.drain(block.clone()).collect();
+        let to = if to > *block.start() { to - run.len() } else { to };
+        self.sequence.splice(to..to, run);
+        self.place();
+        true
     }
 }
 
@@ -286,6 +395,61 @@ fn turning(positions: &[Vec3], triangles: &[[u32; 3]], order: &[u32], window: us
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::order::nehab::feedback_arc_set::backward_weight;
+
+    fn arc(from: u32, to: u32, weight: u64) -> Arc {
+        Arc { from, to, weight }
+    }
+
+    fn successions(sequence: &[u32]) -> usize {
+        sequence.windows(2).filter(|w| w[1] == w[0] + 1).count()
+    }
+
+    /// With no arcs every piece follows its predecessor again; an arc that a join would break
+    /// stops that join, and the other run moves instead where it can.
+    #[test]
+    fn successions_are_joined_unless_an_arc_objects() {
+        assert_eq!(keep_successions(vec![2, 0, 3, 1], &[]), [0, 1, 2, 3]);
+        // 2 must precede 1: joining 0–1 moves 0 (crossing nothing it has an arc with), and 1–2
+        // cannot be joined either way without drawing 1 before 2.
+        assert_eq!(keep_successions(vec![0, 2, 1], &[arc(2, 1, 5)]), [2, 0, 1]);
+    }
+
+    /// On random graphs the result is a permutation, the backward weight never grows and no
+    /// succession is lost.
+    #[test]
+    fn joining_never_puts_more_weight_backward() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |bound: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % bound
+        };
+        for _ in 0..200 {
+            let n = 2 + next(14) as u32;
+            let mut sequence: Vec<u32> = (0..n).collect();
+            for i in (1..sequence.len()).rev() {
+                sequence.swap(i, next(i as u64 + 1) as usize);
+            }
+            let mut arcs = Vec::new();
+            for a in 0..n {
+                for b in a + 1..n {
+                    match next(4) {
+                        0 => arcs.push(arc(a, b, 1 + next(9))),
+                        1 => arcs.push(arc(b, a, 1 + next(9))),
+                        _ => {}
+                    }
+                }
+            }
+            let joined = keep_successions(sequence.clone(), &arcs);
+            let mut sorted = joined.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, (0..n).collect::<Vec<_>>());
+            assert!(backward_weight(&joined, &arcs) <= backward_weight(&sequence, &arcs), "{sequence:?} {arcs:?}");
+            assert!(successions(&joined) >= successions(&sequence));
+        }
+    }
 
     /// A strip of quads along x: triangles (2i, 2i+1) share vertices with their neighbours.
     fn strip(quads: u32) -> Vec<[u32; 3]> {
