@@ -46,10 +46,12 @@
 //! fails on four of eleven models with step 5 (six without): OVR on armadillo (1.049 against
 //! 1.048) and on the two unwelded characters, where no cache order helps, and FIFO-16 on spot
 //! (+1.4%) (paper-figures/README.md has the table). Time: the 42 small views dominate. By `triorder
-//! bench` (median of 11, AMD EPYC, the views on both threads) it is 2.4–3× meshopt-overdraw's
-//! on six of the large models, 3.1–7× on the other meshes over 4k triangles, and 20–100× on the
-//! small characters, where the raster's per-view cost does not shrink with the mesh. A mesh no
-//! cut fits (RiggedSimple) is one piece, returned without drawing views: 1.2–1.35×.
+//! bench` at `0d608d2` (one run, median of 11, AMD EPYC, the views on both threads) it is
+//! 1.75–2.9× meshopt-overdraw's on the eleven models from 11k triangles up but three characters
+//! (BrainStem, Xbot and Soldier, 3.3–3.4×), 3.4–4.8× on CesiumMan, spot and pirate, 8× on
+//! bunny_2k and 17–33× on the small characters, where the raster's per-view cost does not
+//! shrink with the mesh. A mesh no cut fits (RiggedSimple) is one piece, returned without
+//! drawing views: 1.2–1.35×.
 
 use std::collections::BTreeSet;
 use std::ops::RangeInclusive;
