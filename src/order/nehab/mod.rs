@@ -23,6 +23,7 @@
 
 pub mod feedback_arc_set;
 pub mod overdraw_graph;
+pub mod patch_graph;
 pub(crate) mod planar_clusters;
 
 use feedback_arc_set::greedy_order;
