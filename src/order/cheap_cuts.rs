@@ -48,15 +48,20 @@
 //! ordering there before step 5 (still 2–9% below meshopt-overdraw), and holding it within 2%
 //! with `far` costs the overdraw that beats meshopt-overdraw: the trade-off
 //! `experiments/cheap-cuts-intel-tradeoff.toml` sweeps. Held out, one of the two main targets
-//! fails on four of eleven models with step 5 (six without): OVR on armadillo (1.049 against
-//! 1.048) and on the two unwelded characters, where no cache order helps, and FIFO-16 on spot
-//! (+1.4%) (paper-figures/README.md has the table). Time: the 42 small views dominate. By `triorder
-//! bench` at `0d608d2` (one run, median of 11, AMD EPYC, the views on both threads) it is
-//! 1.75–2.9× meshopt-overdraw's on the eleven models from 11k triangles up but three characters
-//! (BrainStem, Xbot and Soldier, 3.3–3.4×), 3.4–4.8× on CesiumMan, spot and pirate, 8× on
-//! bunny_2k and 17–33× on the small characters, where the raster's per-view cost does not
-//! shrink with the mesh. A mesh no cut fits (RiggedSimple) is one piece, returned without
-//! drawing views: 1.2–1.35×.
+//! fails on five of eleven models: OVR on armadillo (1.048 against 1.0476) and on the two
+//! unwelded characters, where no cache order helps, and FIFO-16 on spot (+1.5%) and, by 0.01%,
+//! on dragon_vrip_res4 (paper-figures/README.md has the table).
+//!
+//! **Time.** Drawn from 42 views, the graph cost every triangle's setup in every view: by
+//! `triorder bench` at `0d608d2` cheap-cuts took 1.75–2.9× meshopt-overdraw's time from 11k
+//! triangles up but three characters, 3.3–4.8× on six more and 17–33× on the small
+//! characters. The estimate ([`patch_arcs`], the default since, with nothing tuned for it) puts
+//! it at 0.81–2.6× on all 24 shared meshes (bench at `f6d12bb`, median of 11, AMD EPYC), at
+//! about the views' overdraw: within 0.0012 of it on the tuning models (lower on four), within
+//! 0.0025 on the welded held-out models but the pirate (1.123 against 1.076), and 0.008–0.07
+//! higher on the layered characters, still at most meshopt-overdraw's there
+//! (`experiments/cheap-cuts-graphs.toml`). A mesh no cut fits (RiggedSimple) is one piece,
+//! returned without a graph.
 
 use std::ops::RangeInclusive;
 
