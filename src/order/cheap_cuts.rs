@@ -101,14 +101,14 @@ const VIEWS: ParamInfo = ParamInfo {
     name: "views",
     default: "42",
     kind: ParamKind::Choice(&["12", "42", "162", "642"]),
-    help: "icosahedral views the overdraw graph is sampled from",
+    help: "icosahedral views the overdraw graph is drawn from, with graph=views",
 };
 
 const RES: ParamInfo = ParamInfo {
     name: "res",
     default: "64",
     kind: ParamKind::Int { min: 8, max: 4096 },
-    help: "resolution of the overdraw graph's views",
+    help: "resolution of the overdraw graph's views, with graph=views",
 };
 
 /// The second FIFO the cuts are costed in: Intel's 128 entries (Kapoulkine 2017, the `intel`
