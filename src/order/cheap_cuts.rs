@@ -48,9 +48,10 @@
 //! ordering there before step 5 (still 2–9% below meshopt-overdraw), and holding it within 2%
 //! with `far` costs the overdraw that beats meshopt-overdraw: the trade-off
 //! `experiments/cheap-cuts-intel-tradeoff.toml` sweeps. Held out, one of the two main targets
-//! fails on five of eleven models: OVR on armadillo (1.048 against 1.0476) and on the two
-//! unwelded characters, where no cache order helps, and FIFO-16 on spot (+1.5%) and, by 0.01%,
-//! on dragon_vrip_res4 (paper-figures/README.md has the table).
+//! fails on eight of seventeen meshes: OVR on armadillo (1.048 against 1.0476) and on the three
+//! unwelded characters, where no cache order helps, and FIFO-16 on spot (+1.5%), Xbot, Michelle
+//! and, by 0.01%, dragon_vrip_res4 (paper-figures/README.md has the table, and the fronts that
+//! show a setting winning both on all of them but dragon_vrip_res4).
 //!
 //! **Time.** Drawn from 42 views, the graph cost every triangle's setup in every view: by
 //! `triorder bench` at `0d608d2` cheap-cuts took 1.75–2.9× meshopt-overdraw's time from 11k
