@@ -76,38 +76,39 @@ fn one_pass_equals_pair_by_pair_on_bunny_2k_with_internal_overdraw() {
 /// layers come in.
 #[test]
 fn layers_in_any_order_give_a_total_order_front_to_back() {
-    let k = 6;
-    let mesh = generate(&format!("layers:{k}"));
-    // Layers drawn in a scrambled order: cluster i is layer `shuffle[i]`.
-    let shuffle = [2usize, 5, 0, 3, 1, 4];
-    let triangles: Vec<[u32; 3]> =
-        shuffle.iter().flat_map(|&l| [mesh.triangles[2 * l], mesh.triangles[2 * l + 1]]).collect();
-    let (graph, _) = graphs(&mesh, &triangles, &runs(2 * k, k), "ico:162", 64);
-    let arcs = graph.arcs();
-    assert_eq!(arcs.len(), k * (k - 1) / 2, "{arcs:?}");
-    for arc in &arcs {
-        assert!(shuffle[arc.from as usize] > shuffle[arc.to as usize], "{arc:?}");
-    }
-    let order: Vec<usize> = greedy_order(k, &arcs).iter().map(|&c| shuffle[c as usize]).collect();
-    assert_eq!(order, [5, 4, 3, 2, 1, 0]);
+    let (mesh, triangles) = scrambled_layers();
+    let (graph, _) = graphs(&mesh, &triangles, &runs(2 * LAYERS, LAYERS), "ico:162", 64);
+    assert_front_to_back(&graph.arcs());
 }
 
 /// The graph estimated from surface patches (cheap-cuts' default) says what the drawn one says
-/// on the scrambled layers: every arc from a higher layer to a lower one, and the greedy order
-/// top to bottom.
+/// on the scrambled layers.
 #[test]
 fn the_estimated_graph_also_orders_layers_front_to_back() {
-    let k = 6;
-    let mesh = generate(&format!("layers:{k}"));
-    let shuffle = [2usize, 5, 0, 3, 1, 4];
-    let triangles: Vec<[u32; 3]> =
-        shuffle.iter().flat_map(|&l| [mesh.triangles[2 * l], mesh.triangles[2 * l + 1]]).collect();
-    let arcs = patch_arcs(&mesh.positions, &triangles, &runs(2 * k, k));
-    assert_eq!(arcs.len(), k * (k - 1) / 2, "{arcs:?}");
-    for arc in &arcs {
-        assert!(shuffle[arc.from as usize] > shuffle[arc.to as usize], "{arc:?}");
+    let (mesh, triangles) = scrambled_layers();
+    assert_front_to_back(&patch_arcs(&mesh.positions, &triangles, &runs(2 * LAYERS, LAYERS)));
+}
+
+const LAYERS: usize = 6;
+
+/// Layers drawn in a scrambled order: cluster i is layer `SHUFFLE[i]`.
+const SHUFFLE: [usize; LAYERS] = [2, 5, 0, 3, 1, 4];
+
+/// `layers:6` with its two triangles a layer listed in the order of [`SHUFFLE`].
+fn scrambled_layers() -> (Mesh, Vec<[u32; 3]>) {
+    let mesh = generate(&format!("layers:{LAYERS}"));
+    let triangles = SHUFFLE.iter().flat_map(|&l| [mesh.triangles[2 * l], mesh.triangles[2 * l + 1]]).collect();
+    (mesh, triangles)
+}
+
+/// An arc between every pair of layers, each from the higher to the lower, and the greedy order
+/// top to bottom.
+fn assert_front_to_back(arcs: &[triorder::order::nehab::overdraw_graph::Arc]) {
+    assert_eq!(arcs.len(), LAYERS * (LAYERS - 1) / 2, "{arcs:?}");
+    for arc in arcs {
+        assert!(SHUFFLE[arc.from as usize] > SHUFFLE[arc.to as usize], "{arc:?}");
     }
-    let order: Vec<usize> = greedy_order(k, &arcs).iter().map(|&c| shuffle[c as usize]).collect();
+    let order: Vec<usize> = greedy_order(LAYERS, arcs).iter().map(|&c| SHUFFLE[c as usize]).collect();
     assert_eq!(order, [5, 4, 3, 2, 1, 0]);
 }
 
