@@ -19,8 +19,8 @@
 //!   `optimizeVertexCache` followed by `optimizeOverdraw` (threshold 1.05), meshoptimizer's take
 //!   on the same paper; their overdraw is compared in the experiments (it needs rendering).
 //!   `cheap-cuts` (ours, issue 19) is timed against the same pair, with its adjacency given and
-//!   its 42-view overdraw graph on as many threads as `RAYON_NUM_THREADS` allows (1 for a
-//!   one-thread comparison).
+//!   its default overdraw graph, estimated from surface patches on one thread (with
+//!   `graph=views` its views are drawn on as many threads as `RAYON_NUM_THREADS` allows).
 //! - Every timing calls each side twice a round on the same input, which is how it is done
 //!   everywhere here. On the smallest meshes that also measures a branch predictor that has
 //!   learnt the whole run: ordering RiggedSimple (188 triangles) takes meshoptimizer 12–19 µs

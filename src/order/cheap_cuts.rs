@@ -161,12 +161,24 @@ fn build(params: &Params) -> Box<dyn Ordering> {
         far: params.float(&FAR_BUDGET),
         min: params.int(&MIN) as usize,
         clusters: params.int(&CLUSTERS) as usize,
-        views: params.word(&VIEWS).parse().expect("the schema lists only numbers"),
-        res: params.int(&RES) as u32,
-        patches: params.word(&GRAPH) == "patches",
+        graph: match params.word(&GRAPH) {
+            "views" => Graph::Views {
+                views: params.word(&VIEWS).parse().expect("the schema lists only numbers"),
+                res: params.int(&RES) as u32,
+            },
+            _ => Graph::Patches,
+        },
         cache: params.int(&CACHE) as u32,
         lru: params.int(&LRU) as usize,
     })
+}
+
+/// How the pieces' overdraw graph is found (`graph=`): estimated, or drawn from `views` views at
+/// `res`².
+#[derive(Clone, Copy)]
+enum Graph {
+    Patches,
+    Views { views: u32, res: u32 },
 }
 
 struct CheapCuts {
@@ -174,9 +186,7 @@ struct CheapCuts {
     far: f64,
     min: usize,
     clusters: usize,
-    views: u32,
-    res: u32,
-    patches: bool,
+    graph: Graph,
     cache: u32,
     lru: usize,
 }
@@ -193,18 +203,19 @@ impl Ordering for CheapCuts {
             .collect();
         let turn = turning(&mesh.positions, &mesh.triangles, &order, self.min);
         let starts = cheapest_cuts(&costs, &turn, self.min, self.clusters);
-        // One piece has one order: the views would be drawn for nothing (RiggedSimple's 188
-        // triangles: 42 views at 64² were about 96% of the time).
+        // One piece has one order: a graph would be built for nothing (RiggedSimple's 188
+        // triangles: drawing 42 views at 64² was about 96% of the time).
         if starts.len() == 2 {
             return Ok(order.into());
         }
         let triangles = mesh.triangles_in_order(&order);
         let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &starts };
-        let arcs = if self.patches {
-            patch_arcs(&mesh.positions, &triangles, &starts)
-        } else {
-            let cameras = ViewSet::Ico(self.views).cameras(Framing::of(&mesh.positions), 0);
-            one_pass(draw, &cameras, self.res).map_err(|e| naming_mesh(&mesh.name, e))?.arcs()
+        let arcs = match self.graph {
+            Graph::Patches => patch_arcs(&mesh.positions, &triangles, &starts),
+            Graph::Views { views, res } => {
+                let cameras = ViewSet::Ico(views).cameras(Framing::of(&mesh.positions), 0);
+                one_pass(draw, &cameras, res).map_err(|e| naming_mesh(&mesh.name, e))?.arcs()
+            }
         };
         let sequence = keep_successions(greedy_order(draw.cluster_count(), &arcs), &arcs);
         Ok(Clustered::concat(sequence.iter().map(|&c| &order[starts[c as usize]..starts[c as usize + 1]])).into())

@@ -89,23 +89,30 @@ impl OverdrawGraph {
     /// The paper's arcs: toward the cheaper order of each pair, weighted by the net saving; none
     /// on ties.
     pub fn arcs(&self) -> Vec<Arc> {
-        let mut arcs = Vec::new();
-        for a in 0..self.n {
-            for b in a + 1..self.n {
-                let (ab, ba) = (self.saved(a, b), self.saved(b, a));
-                let (from, to) = if ab > ba { (a, b) } else { (b, a) };
-                if ab != ba {
-                    arcs.push(Arc { from: from as u32, to: to as u32, weight: ab.abs_diff(ba) });
-                }
-            }
-        }
-        arcs
+        arcs_of(self.n, |a, b| self.saved(a, b))
     }
 
     fn add(mut self, other: OverdrawGraph) -> OverdrawGraph {
         self.saved.iter_mut().zip(other.saved).for_each(|(s, o)| *s += o);
         self
     }
+}
+
+/// The paper's arcs between `n` clusters from `saved(a, b)` (what drawing a first saves of b):
+/// toward the cheaper order of each pair, weighted by the net saving; none on ties. Shared by the
+/// drawn graph and the estimated one ([`super::patch_graph`]).
+pub(crate) fn arcs_of(n: usize, saved: impl Fn(usize, usize) -> u64) -> Vec<Arc> {
+    let mut arcs = Vec::new();
+    for a in 0..n {
+        for b in a + 1..n {
+            let (ab, ba) = (saved(a, b), saved(b, a));
+            if ab != ba {
+                let (from, to) = if ab > ba { (a, b) } else { (b, a) };
+                arcs.push(Arc { from: from as u32, to: to as u32, weight: ab.abs_diff(ba) });
+            }
+        }
+    }
+    arcs
 }
 
 /// The graph from one rasterization per camera: each view's fragments as [`DepthLayers`] (a few

@@ -33,7 +33,7 @@
 
 use glam::DVec3;
 
-use super::overdraw_graph::Arc;
+use super::overdraw_graph::{Arc, arcs_of};
 
 /// About this many patches at most (plus one per cluster, where a run ends short): the pairs,
 /// P²/2, then cost about a quarter of a millisecond (RobotExpressive, 513 patches, AMD EPYC).
@@ -165,22 +165,11 @@ impl Patches {
 }
 
 /// The paper's arcs from `saved` (row a, column b: what drawing a first saves of b), weights
-/// scaled so that the largest entry is 2⁴⁰.
+/// scaled so that the largest entry is 2⁴⁰ and rounded.
 fn arcs(saved: &[f64], n: usize) -> Vec<Arc> {
     let most = saved.iter().copied().fold(0.0, f64::max);
     let scale = if most > 0.0 { (1u64 << 40) as f64 / most } else { 0.0 };
-    let weight = |a: usize, b: usize| (saved[a * n + b] * scale).round() as u64;
-    let mut arcs = Vec::new();
-    for a in 0..n {
-        for b in a + 1..n {
-            let (ab, ba) = (weight(a, b), weight(b, a));
-            if ab != ba {
-                let (from, to) = if ab > ba { (a, b) } else { (b, a) };
-                arcs.push(Arc { from: from as u32, to: to as u32, weight: ab.abs_diff(ba) });
-            }
-        }
-    }
-    arcs
+    arcs_of(n, |a, b| (saved[a * n + b] * scale).round() as u64)
 }
 
 #[cfg(test)]
