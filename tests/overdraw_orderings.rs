@@ -86,7 +86,7 @@ fn layers_in_any_order_give_a_total_order_front_to_back() {
 #[test]
 fn the_estimated_graph_also_orders_layers_front_to_back() {
     let (mesh, triangles) = scrambled_layers();
-    assert_front_to_back(&patch_arcs(&mesh.positions, &triangles, &runs(2 * LAYERS, LAYERS)));
+    assert_front_to_back(&patch_arcs(&mesh.positions, &triangles, &runs(2 * LAYERS, LAYERS), &[]));
 }
 
 const LAYERS: usize = 6;
@@ -130,7 +130,7 @@ fn the_estimated_graph_agrees_with_the_drawn_one_on_rocker_arm() {
     let draw = ClusteredDraw { positions: &mesh.positions, triangles: &triangles, starts: &starts };
     let cameras = ViewSet::Ico(42).cameras(Framing::of(&mesh.positions), 0);
     let drawn = one_pass(draw, &cameras, 64).unwrap().arcs();
-    let estimated = patch_arcs(&mesh.positions, &triangles, &starts);
+    let estimated = patch_arcs(&mesh.positions, &triangles, &starts, &[]);
     let total: u64 = drawn.iter().map(|a| a.weight).sum();
     let same_way: u64 =
         drawn.iter().filter(|a| estimated.iter().any(|e| (e.from, e.to) == (a.from, a.to))).map(|a| a.weight).sum();

@@ -65,7 +65,7 @@ impl Ordering for Sander07 {
 pub(crate) fn sander07(mesh: &Mesh, vertex_triangles: &Csr, cache: u32, lambda: f64) -> Clustered {
     let patches = patches(mesh, vertex_triangles, cache, lambda);
     let clusters: Vec<&[u32]> = patches.starts.windows(2).map(|w| &patches.order[w[0]..w[1]]).collect();
-    let sorted = dot_rule_sort(&mesh.positions, &mesh.triangles, &clusters);
+    let sorted = dot_rule_sort(&mesh.positions, &mesh.triangles, &clusters, Facing::Unit);
     Clustered::concat(sorted.iter().map(|&c| clusters[c]))
 }
 
@@ -149,11 +149,28 @@ impl Fifo {
     }
 }
 
+/// How a cluster's facing enters the dot rule's key.
+#[derive(Clone, Copy)]
+pub(crate) enum Facing {
+    /// The paper's: N(P), the area-weighted normal normalised.
+    Unit,
+    /// The area-weighted normal divided by the area: N(P) times how much the cluster faces one
+    /// way (1 for a flat one, 0 for a closed one). For clusters that may be closed parts, whose
+    /// normals cancel and whose normalised sum is the direction of rounding noise.
+    Mean,
+}
+
 /// Indices of `clusters` (lists of triangle ids) in dot-rule order: decreasing
-/// `(C(P) − C(M)) · N(P)`, stable. Computed in f64 on the positions in their unit frame
-/// ([`unit_positions64`]), where the keys are the world keys divided by the radius (the order is
-/// the same) and the same bits wherever the mesh stands and whatever its units.
-pub(crate) fn dot_rule_sort(positions: &[Vec3], triangles: &[[u32; 3]], clusters: &[&[u32]]) -> Vec<usize> {
+/// `(C(P) − C(M)) · N(P)` (with `facing` deciding N(P)), stable. Computed in f64 on the positions
+/// in their unit frame ([`unit_positions64`]), where the keys are the world keys divided by the
+/// radius (the order is the same) and the same bits wherever the mesh stands and whatever its
+/// units.
+pub(crate) fn dot_rule_sort(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    clusters: &[&[u32]],
+    facing: Facing,
+) -> Vec<usize> {
     let positions = unit_positions64(positions);
     // Per cluster: Σ area·centroid, Σ area, Σ area-weighted normal (twice the area, the cross product).
     let sums: Vec<(DVec3, f64, DVec3)> = clusters
@@ -171,7 +188,13 @@ pub(crate) fn dot_rule_sort(positions: &[Vec3], triangles: &[[u32; 3]], clusters
     let mesh_centre = if area > 0.0 { total / area } else { DVec3::ZERO };
     let key: Vec<f64> = sums
         .iter()
-        .map(|&(c, a, n)| if a > 0.0 { (c / a - mesh_centre).dot(n.normalize_or_zero()) } else { 0.0 })
+        .map(|&(c, a, n)| {
+            let facing = match facing {
+                Facing::Unit => n.normalize_or_zero(),
+                Facing::Mean => n / a,
+            };
+            if a > 0.0 { (c / a - mesh_centre).dot(facing) } else { 0.0 }
+        })
         .collect();
     let mut sorted: Vec<usize> = (0..clusters.len()).collect();
     sorted.sort_by(|&x, &y| key[y].total_cmp(&key[x]));
@@ -239,6 +262,6 @@ mod tests {
         }
         let clusters: [&[u32]; 3] = [&[0, 1], &[2, 3], &[4, 5]];
         // Centre z = 0.5: keys 0·... = −0.5, +0.5, and 0 (the −z square sits at the centre).
-        assert_eq!(dot_rule_sort(&positions, &triangles, &clusters), [1, 2, 0]);
+        assert_eq!(dot_rule_sort(&positions, &triangles, &clusters, Facing::Unit), [1, 2, 0]);
     }
 }

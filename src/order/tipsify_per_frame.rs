@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use super::sander07::{LAMBDA, dot_rule_sort, patches};
+use super::sander07::{Facing, LAMBDA, dot_rule_sort, patches};
 use super::tipsify::FIFO_CACHE;
 use super::{Clustered, Lookup, Cost, Method, Ordering, Orders, Params};
 use crate::error::Result;
@@ -46,7 +46,7 @@ impl Ordering for TipsifyPerFrame {
             .frames
             .par_iter()
             .map(|positions| {
-                let sorted = dot_rule_sort(positions, &mesh.triangles, &clusters);
+                let sorted = dot_rule_sort(positions, &mesh.triangles, &clusters, Facing::Unit);
                 Clustered::concat(sorted.iter().map(|&c| clusters[c]))
             })
             .collect();

@@ -31,9 +31,12 @@
 //! Cost: O(triangles) for the patches, then O(P²) for P patches ([`PATCHES`] at most, plus one
 //! per cluster), in loops the compiler vectorizes.
 
+use std::ops::Range;
+
 use glam::DVec3;
 
 use super::overdraw_graph::{Arc, arcs_of};
+use crate::mesh::Framing;
 
 /// About this many patches at most (plus one per cluster, where a run ends short): the pairs,
 /// P²/2, then cost about a quarter of a millisecond (RobotExpressive, 513 patches, AMD EPYC).
@@ -46,8 +49,80 @@ const LEAST: usize = 4;
 /// The estimated graph's arcs for clusters given as runs of a draw list: cluster `c` is
 /// `triangles[starts[c]..starts[c + 1]]`. Weights are the estimates scaled so that the largest
 /// `saved` is 2⁴⁰, rounded.
-pub fn patch_arcs(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Vec<Arc> {
+///
+/// Patches are runs of consecutive triangles, which is right where the draw list walks the
+/// surface (a cache order). In the `scattered` ranges it need not: consecutive triangles there
+/// may lie anywhere (cheap-cuts' loose units, sorted by the dot rule), and a patch of them would
+/// have a centre in empty space and a normal that their own normals cancel. There, within each
+/// cluster, the patches are taken along a Hilbert curve through the triangles' centroids instead.
+/// A cluster is the same set of triangles either way; only its patches change.
+pub fn patch_arcs(
+    positions: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    starts: &[usize],
+    scattered: &[Range<usize>],
+) -> Vec<Arc> {
+    let regrouped;
+    let triangles = if scattered.is_empty() {
+        triangles
+    } else {
+        regrouped = along_curve(positions, triangles, starts, scattered);
+        &regrouped
+    };
     arcs(&saved(positions, triangles, starts), starts.len() - 1)
+}
+
+/// Bits per axis of the curve that regroups scattered ranges: 2¹⁰ cells along each, finer than
+/// any patch.
+const CURVE_BITS: u32 = 10;
+
+/// `triangles` with each piece of a `scattered` range that lies in one cluster sorted along a
+/// Z-order (Morton) curve through the triangles' centroids, in the bounding cube of `positions`
+/// (ties keep their order). Z-order rather than Hilbert: the key is a few shifts against about a
+/// thousand instructions, and any curve that keeps cells together makes the patches compact.
+/// One stable radix sort of every scattered triangle, keyed by its cluster and then its cell;
+/// `scattered` is in increasing order, without overlaps.
+fn along_curve(
+    positions: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    starts: &[usize],
+    scattered: &[Range<usize>],
+) -> Vec<[u32; 3]> {
+    let (lo, hi) = Framing::bounds_of(positions);
+    let (lo, hi) = (lo.as_vec3(), hi.as_vec3());
+    let cells = ((1u32 << CURVE_BITS) - 1) as f32;
+    let scale = cells / (hi - lo).max_element().max(f32::MIN_POSITIVE);
+    let cell = |t: &[u32; 3]| {
+        let centre = (positions[t[0] as usize] + positions[t[1] as usize] + positions[t[2] as usize]) / 3.0;
+        let [x, y, z] = ((centre - lo) * scale).to_array().map(|c| c.clamp(0.0, cells) as u32);
+        u64::from(spread(x) | spread(y) << 1 | spread(z) << 2)
+    };
+    let mut keyed: Vec<(u64, [u32; 3])> = Vec::with_capacity(scattered.iter().map(|r| r.len()).sum());
+    let mut cluster = 0;
+    for i in scattered.iter().flat_map(|r| r.clone()) {
+        while starts[cluster + 1] <= i {
+            cluster += 1;
+        }
+        keyed.push(((cluster as u64) << (3 * CURVE_BITS) | cell(&triangles[i]), triangles[i]));
+    }
+    radsort::sort_by_key(&mut keyed, |k| k.0);
+    // The sort kept each cluster's places in the ranges, which come in increasing order: they
+    // are refilled in turn.
+    let mut regrouped = triangles.to_vec();
+    for (place, (_, t)) in scattered.iter().flat_map(|r| r.clone()).zip(keyed) {
+        regrouped[place] = t;
+    }
+    regrouped
+}
+
+/// The low [`CURVE_BITS`] bits of `x` moved to every third bit (the usual magic-number
+/// spreading, for 10 bits).
+fn spread(x: u32) -> u32 {
+    let mut x = x & 0x3ff;
+    x = (x | x << 16) & 0x0300_00ff;
+    x = (x | x << 8) & 0x0300_f00f;
+    x = (x | x << 4) & 0x030c_30c3;
+    (x | x << 2) & 0x0924_9249
 }
 
 /// The estimated `saved` matrix, row a, column b: the area of b that drawing a first hides,
@@ -92,12 +167,10 @@ struct Patches {
 }
 
 impl Patches {
-    fn of(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Patches {
+        fn of(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Patches {
         let per_patch = triangles.len().div_ceil(PATCHES).max(LEAST);
         // The frame: centred on the bounding box, its largest side scaled to 1.
-        let (lo, hi) = positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-        });
+        let (lo, hi) = Framing::bounds_of(positions);
         let middle = (lo + hi) * 0.5;
         let unit = 1.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
         let mut patches = Patches {
@@ -175,10 +248,41 @@ fn arcs(saved: &[f64], n: usize) -> Vec<Arc> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Framing;
     use crate::order::nehab::overdraw_graph::{ClusteredDraw, one_pass};
     use crate::raster::ViewSet;
     use glam::Vec3;
+
+    /// Scattered ranges are regrouped within each cluster only: every cluster keeps its
+    /// triangles, everything outside the ranges stays in place, and inside a range the part in
+    /// one cluster follows the curve (its cells never decrease), ties in their first order.
+    #[test]
+    fn scattered_ranges_are_regrouped_within_their_clusters() {
+        // 40 triangles along a line, given in a scrambled order, each its own three vertices.
+        let positions: Vec<Vec3> = (0..40)
+            .flat_map(|i| {
+                let x = ((i * 17) % 40) as f32;
+                [Vec3::new(x, 0.0, 0.0), Vec3::new(x + 0.5, 0.0, 0.0), Vec3::new(x, 0.5, 0.0)]
+            })
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..40).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        let starts = [0, 10, 25, 40];
+        let scattered = [3..18, 30..35];
+        let regrouped = along_curve(&positions, &triangles, &starts, &scattered);
+        let sorted = |ts: &[[u32; 3]]| {
+            let mut ts = ts.to_vec();
+            ts.sort_unstable();
+            ts
+        };
+        for cluster in starts.windows(2) {
+            assert_eq!(sorted(&regrouped[cluster[0]..cluster[1]]), sorted(&triangles[cluster[0]..cluster[1]]));
+        }
+        let inside = |i: usize| scattered.iter().any(|r| r.contains(&i));
+        assert!((0..40).filter(|&i| !inside(i)).all(|i| regrouped[i] == triangles[i]));
+        let x = |t: &[u32; 3]| positions[t[0] as usize].x;
+        for part in [3..10, 10..18, 30..35] {
+            assert!(regrouped[part.clone()].windows(2).all(|w| x(&w[0]) <= x(&w[1])), "{part:?}");
+        }
+    }
 
     /// Two squares facing +z, one above the other and offset sideways, and a third far off to
     /// the side: the upper hides the lower from above (the arc the drawn graph has too), and
@@ -192,7 +296,7 @@ mod tests {
         let quad = |o: u32| [[o, o + 1, o + 2], [o, o + 2, o + 3]];
         let triangles: Vec<[u32; 3]> = [quad(0), quad(4), quad(8)].concat();
         let starts = [0, 2, 4, 6];
-        let estimated = patch_arcs(&positions, &triangles, &starts);
+        let estimated = patch_arcs(&positions, &triangles, &starts, &[]);
         let upper_first = |arcs: &[Arc]| arcs.iter().find(|a| (a.from, a.to) == (1, 0)).map(|a| a.weight);
         let heaviest = estimated.iter().map(|a| a.weight).max().unwrap();
         assert_eq!(upper_first(&estimated), Some(heaviest), "{estimated:?}");
@@ -235,8 +339,8 @@ mod tests {
         let mesh = crate::mesh::procedural::generate("helix:3", 0).unwrap().unwrap();
         let starts: Vec<usize> = (0..=6).map(|k| k * mesh.triangle_count() / 6).collect();
         let moved: Vec<Vec3> = mesh.positions.iter().map(|p| *p * 4.0 + Vec3::new(10.0, -3.0, 2.0)).collect();
-        let a = patch_arcs(&mesh.positions, &mesh.triangles, &starts);
-        let b = patch_arcs(&moved, &mesh.triangles, &starts);
+        let a = patch_arcs(&mesh.positions, &mesh.triangles, &starts, &[]);
+        let b = patch_arcs(&moved, &mesh.triangles, &starts, &[]);
         assert!(!a.is_empty());
         assert_eq!(a.len(), b.len());
         for (x, y) in a.iter().zip(&b) {
