@@ -100,10 +100,11 @@ where
             _ => String::new(),
         }
     };
-    let value = |v: &f64| number(*v);
+    let (x_span, y_span) = (chart.x_range().end - chart.x_range().start, chart.y_range().end - chart.y_range().start);
+    let (x_value, y_value) = (move |v: &f64| tick(*v, x_span), move |v: &f64| tick(*v, y_span));
     let mut mesh = chart.configure_mesh();
-    mesh.x_label_formatter(&value)
-        .y_label_formatter(&value)
+    mesh.x_label_formatter(&x_value)
+        .y_label_formatter(&y_value)
         .x_desc(frame.x_desc.as_str())
         .y_desc(frame.y_desc.as_str())
         .label_style((FONT, 12))
@@ -437,6 +438,23 @@ pub fn number(v: f64) -> String {
     if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
 }
 
+/// A tick label of an axis `span` long: [`number`], with as many more decimals as ticks about a
+/// tenth of the span apart need to read apart (on an axis from 2.2286 to 2.2305, four
+/// significant digits label every tick 2.229).
+fn tick(v: f64, span: f64) -> String {
+    let plain = number(v);
+    if v == 0.0 || !(span > 0.0 && span.is_finite()) || !(1e-3..1e6).contains(&v.abs()) {
+        return plain;
+    }
+    let needed = (-(span / 10.0).log10().floor() as i32).clamp(0, 12) as usize;
+    let digits = plain.split_once('.').map_or(0, |(_, fraction)| fraction.len());
+    if needed <= digits {
+        return plain;
+    }
+    let text = format!("{v:.needed$}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// `v` with `digits` significant digits in plain decimals, never e-notation (`0.0000123`,
 /// `1.23`), for tables whose numbers are read side by side.
 pub fn significant(v: f64, digits: usize) -> String {
@@ -466,6 +484,17 @@ pub fn wrap(text: &str, max: usize) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Ticks on a narrow axis get the decimals that tell them apart; elsewhere they read as
+    /// [`number`] writes them.
+    #[test]
+    fn ticks_of_a_narrow_axis_read_apart() {
+        assert_eq!(tick(2.2288, 0.002), "2.2288");
+        assert_eq!(tick(2.229, 0.002), "2.229");
+        assert_eq!(tick(0.72, 0.2), "0.72");
+        assert_eq!(tick(1.0512, 0.1), number(1.0512));
+        assert_eq!(tick(0.0, 0.002), "0");
+    }
 
     #[test]
     fn numbers_and_wrapping() {

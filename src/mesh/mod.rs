@@ -22,6 +22,7 @@ pub mod simplify;
 pub mod source;
 pub mod subdivide;
 pub mod topology;
+pub mod z_order;
 
 use glam::Vec3;
 

@@ -28,6 +28,7 @@ use super::layers::{self, DepthLayers, LaneRanks};
 use super::views::Camera;
 use super::{OrderPicks, RasterBackend, ViewCounts};
 use crate::error::{Error, Result};
+use crate::mesh::z_order::ZOrder;
 
 /// Sub-pixel bits of the snapped vertex coordinates.
 const SUBPIXEL_BITS: u32 = 8;
@@ -180,15 +181,8 @@ impl Local {
             .iter()
             .map(centroid)
             .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)));
-        let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let mut keyed: Vec<(u32, u32)> = triangles
-            .iter()
-            .zip(0..)
-            .map(|(t, i)| {
-                let q = ((centroid(t) - lo) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
-                (spread(q.x as u32) | spread(q.y as u32) << 1 | spread(q.z as u32) << 2, i)
-            })
-            .collect();
+        let grid = ZOrder::over(lo, hi);
+        let mut keyed: Vec<(u32, u32)> = triangles.iter().zip(0..).map(|(t, i)| (grid.key(centroid(t)), i)).collect();
         radsort::sort_by_key(&mut keyed, |k| k.0);
         let mut number = vec![u32::MAX; positions.len()];
         let mut order: Vec<u32> = Vec::with_capacity(positions.len());
@@ -211,15 +205,6 @@ impl Local {
             ids: keyed.into_iter().map(|(_, i)| i).collect(),
         }
     }
-}
-
-/// The low 10 bits of `x` spread to every third bit (a Morton code's one axis).
-fn spread(x: u32) -> u32 {
-    let mut x = x & 0x3ff;
-    x = (x | x << 16) & 0x030000ff;
-    x = (x | x << 8) & 0x0300f00f;
-    x = (x | x << 4) & 0x030c30c3;
-    (x | x << 2) & 0x09249249
 }
 
 /// One thread's buffers for [`DepthLayers`]: the fragments and the pixel slots.

@@ -8,9 +8,10 @@
 //! whole mesh. Here the views are integrated analytically instead.
 //!
 //! Cut each cluster into patches of consecutive triangles (a cache order keeps them together on
-//! the surface). Two small patches p and q, with area-weighted normals Np and Nq and centres r
-//! apart along the unit vector u from q to p, overlap on screen only when seen nearly along u,
-//! with p the nearer; summed over all view directions, the overlapping area is
+//! the surface; where the caller says it does not, along a Z-order curve instead). Two small
+//! patches p and q, with area-weighted normals Np and Nq and centres r apart along the unit
+//! vector u from q to p, overlap on screen only when seen nearly along u, with p the nearer;
+//! summed over all view directions, the overlapping area is
 //!
 //! (Np·u)⁺ (Nq·u)⁺ / r²,
 //!
@@ -37,6 +38,7 @@ use glam::DVec3;
 
 use super::overdraw_graph::{Arc, arcs_of};
 use crate::mesh::Framing;
+use crate::mesh::z_order::ZOrder;
 
 /// About this many patches at most (plus one per cluster, where a run ends short): the pairs,
 /// P²/2, then cost about a quarter of a millisecond (RobotExpressive, 513 patches, AMD EPYC).
@@ -72,15 +74,10 @@ pub fn patch_arcs(
     arcs(&saved(positions, triangles, starts), starts.len() - 1)
 }
 
-/// Bits per axis of the curve that regroups scattered ranges: 2¹⁰ cells along each, finer than
-/// any patch.
-const CURVE_BITS: u32 = 10;
-
 /// `triangles` with each piece of a `scattered` range that lies in one cluster sorted along a
-/// Z-order (Morton) curve through the triangles' centroids, in the bounding cube of `positions`
-/// (ties keep their order). Z-order rather than Hilbert: the key is a few shifts against about a
-/// thousand instructions, and any curve that keeps cells together makes the patches compact.
-/// One stable radix sort of every scattered triangle, keyed by its cluster and then its cell;
+/// Z-order curve through the triangles' centroids ([`ZOrder`], over the bounding box of
+/// `positions`; ties keep their order): any curve that keeps cells together makes the patches
+/// compact. One stable radix sort of every scattered triangle, keyed by its cluster and then its cell;
 /// `scattered` is in increasing order, without overlaps.
 fn along_curve(
     positions: &[glam::Vec3],
@@ -89,13 +86,10 @@ fn along_curve(
     scattered: &[Range<usize>],
 ) -> Vec<[u32; 3]> {
     let (lo, hi) = Framing::bounds_of(positions);
-    let (lo, hi) = (lo.as_vec3(), hi.as_vec3());
-    let cells = ((1u32 << CURVE_BITS) - 1) as f32;
-    let scale = cells / (hi - lo).max_element().max(f32::MIN_POSITIVE);
+    let grid = ZOrder::over(lo.as_vec3(), hi.as_vec3());
     let cell = |t: &[u32; 3]| {
         let centre = (positions[t[0] as usize] + positions[t[1] as usize] + positions[t[2] as usize]) / 3.0;
-        let [x, y, z] = ((centre - lo) * scale).to_array().map(|c| c.clamp(0.0, cells) as u32);
-        u64::from(spread(x) | spread(y) << 1 | spread(z) << 2)
+        u64::from(grid.key(centre))
     };
     let mut keyed: Vec<(u64, [u32; 3])> = Vec::with_capacity(scattered.iter().map(|r| r.len()).sum());
     let mut cluster = 0;
@@ -103,7 +97,7 @@ fn along_curve(
         while starts[cluster + 1] <= i {
             cluster += 1;
         }
-        keyed.push(((cluster as u64) << (3 * CURVE_BITS) | cell(&triangles[i]), triangles[i]));
+        keyed.push(((cluster as u64) << 32 | cell(&triangles[i]), triangles[i]));
     }
     radsort::sort_by_key(&mut keyed, |k| k.0);
     // The sort kept each cluster's places in the ranges, which come in increasing order: they
@@ -113,16 +107,6 @@ fn along_curve(
         regrouped[place] = t;
     }
     regrouped
-}
-
-/// The low [`CURVE_BITS`] bits of `x` moved to every third bit (the usual magic-number
-/// spreading, for 10 bits).
-fn spread(x: u32) -> u32 {
-    let mut x = x & 0x3ff;
-    x = (x | x << 16) & 0x0300_00ff;
-    x = (x | x << 8) & 0x0300_f00f;
-    x = (x | x << 4) & 0x030c_30c3;
-    (x | x << 2) & 0x0924_9249
 }
 
 /// The estimated `saved` matrix, row a, column b: the area of b that drawing a first hides,
