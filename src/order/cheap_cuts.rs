@@ -57,21 +57,24 @@
 //! ordering there before step 6 (still 2–9% below meshopt-overdraw), and holding it within 2%
 //! with `far` costs the overdraw that beats meshopt-overdraw: the trade-off
 //! `experiments/cheap-cuts-intel-tradeoff.toml` sweeps. Held out, one of the two main targets
-//! fails on eight of seventeen meshes: OVR on armadillo (1.048 against 1.0476) and on the three
-//! unwelded characters, where no cache order helps, and FIFO-16 on spot (+1.5%), Xbot, Michelle
-//! and, by 0.01%, dragon_vrip_res4 (paper-figures/README.md has the table, and the fronts that
-//! show a setting winning both on all of them but dragon_vrip_res4).
+//! fails on six of seventeen meshes: OVR on armadillo (1.0483 against 1.0476) and on Fox and
+//! RiggedFigure (all loose parts: the dot rule alone, 1.0231 and 1.0245 against meshoptimizer's
+//! 1.0209 and 1.0244), and FIFO-16 on spot (+1.5%), Xbot and Michelle. Step 3 was added after
+//! those characters and Soldier showed what the greedy's fallback order cost them (mean OVR, ico:162
+//! at 512²: Soldier 1.2383 to 1.1684, RobotExpressive 1.1777 to 1.0786, RiggedFigure 1.0772 to
+//! 1.0245, Fox 1.0420 to 1.0231; on the tuning models at most 0.0002). paper-figures/README.md has
+//! the table, and the fronts that show a setting winning both on every miss.
 //!
 //! **Time.** Drawn from 42 views, the graph cost every triangle's setup in every view: by
 //! `triorder bench` at `0d608d2` cheap-cuts took 1.75–2.9× meshopt-overdraw's time from 11k
 //! triangles up but three characters, 3.3–4.8× on six more and 17–33× on the small
 //! characters. The estimate ([`patch_arcs`], the default since, with nothing tuned for it) puts
-//! it at 0.81–2.6× on all 24 shared meshes (bench at `f6d12bb`, median of 11, AMD EPYC), at
-//! about the views' overdraw: within 0.0012 of it on the tuning models (lower on four), within
-//! 0.0025 on the welded held-out models but the pirate (1.123 against 1.076), and 0.008–0.07
-//! higher on the layered characters, still at most meshopt-overdraw's there
-//! (`experiments/cheap-cuts-graphs.toml`). A mesh no cut fits (RiggedSimple) is one piece,
-//! returned without a graph.
+//! it at 0.83–1.7× on the 23 meshes `triorder bench` times (at `7454984`, median of 11, AMD
+//! EPYC), at about the views' overdraw: within 0.0024 of it on the tuning models (lower on three),
+//! within 0.0011 on the welded held-out models but the pirate (1.145 against 1.070), and 0.013–0.069
+//! higher on three layered characters (lower on Soldier and CesiumMan), still below
+//! meshopt-overdraw's there (`experiments/cheap-cuts-graphs.toml`). A mesh no cut fits
+//! (RiggedSimple) is one piece, returned without a graph.
 
 use std::ops::{Range, RangeInclusive};
 
