@@ -56,7 +56,7 @@ const LEAST: usize = 4;
 /// surface (a cache order). In the `scattered` ranges it need not: consecutive triangles there
 /// may lie anywhere (cheap-cuts' loose units, sorted by the dot rule), and a patch of them would
 /// have a centre in empty space and a normal that their own normals cancel. There, within each
-/// cluster, the patches are taken along a Hilbert curve through the triangles' centroids instead.
+/// cluster, the patches are taken along a Z-order curve through the triangles' centroids instead.
 /// A cluster is the same set of triangles either way; only its patches change.
 pub fn patch_arcs(
     positions: &[glam::Vec3],
@@ -77,8 +77,8 @@ pub fn patch_arcs(
 /// `triangles` with each piece of a `scattered` range that lies in one cluster sorted along a
 /// Z-order curve through the triangles' centroids ([`ZOrder`], over the bounding box of
 /// `positions`; ties keep their order): any curve that keeps cells together makes the patches
-/// compact. One stable radix sort of every scattered triangle, keyed by its cluster and then its cell;
-/// `scattered` is in increasing order, without overlaps.
+/// compact. One stable radix sort of every scattered triangle, keyed by its cluster and then its
+/// cell; `scattered` is in increasing order, without overlaps.
 fn along_curve(
     positions: &[glam::Vec3],
     triangles: &[[u32; 3]],
@@ -151,7 +151,7 @@ struct Patches {
 }
 
 impl Patches {
-        fn of(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Patches {
+    fn of(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Patches {
         let per_patch = triangles.len().div_ceil(PATCHES).max(LEAST);
         // The frame: centred on the bounding box, its largest side scaled to 1.
         let (lo, hi) = Framing::bounds_of(positions);
