@@ -64,28 +64,29 @@ pub fn patch_arcs(
     starts: &[usize],
     scattered: &[Range<usize>],
 ) -> Vec<Arc> {
+    let bounds = Framing::bounds_of(positions);
     let regrouped;
     let triangles = if scattered.is_empty() {
         triangles
     } else {
-        regrouped = along_curve(positions, triangles, starts, scattered);
+        regrouped = along_curve(positions, bounds, triangles, starts, scattered);
         &regrouped
     };
-    arcs(&saved(positions, triangles, starts), starts.len() - 1)
+    arcs(&saved(positions, bounds, triangles, starts), starts.len() - 1)
 }
 
 /// `triangles` with each piece of a `scattered` range that lies in one cluster sorted along a
-/// Z-order curve through the triangles' centroids ([`ZOrder`], over the bounding box of
+/// Z-order curve through the triangles' centroids ([`ZOrder`], over `bounds`, the box of
 /// `positions`; ties keep their order): any curve that keeps cells together makes the patches
 /// compact. One stable radix sort of every scattered triangle, keyed by its cluster and then its
 /// cell; `scattered` is in increasing order, without overlaps.
 fn along_curve(
     positions: &[glam::Vec3],
+    (lo, hi): (DVec3, DVec3),
     triangles: &[[u32; 3]],
     starts: &[usize],
     scattered: &[Range<usize>],
 ) -> Vec<[u32; 3]> {
-    let (lo, hi) = Framing::bounds_of(positions);
     let grid = ZOrder::over(lo.as_vec3(), hi.as_vec3());
     let cell = |t: &[u32; 3]| {
         let centre = (positions[t[0] as usize] + positions[t[1] as usize] + positions[t[2] as usize]) / 3.0;
@@ -110,10 +111,11 @@ fn along_curve(
 }
 
 /// The estimated `saved` matrix, row a, column b: the area of b that drawing a first hides,
-/// summed over view directions (areas of the mesh scaled to unit size, per steradian).
-fn saved(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Vec<f64> {
+/// summed over view directions (areas of the mesh scaled to unit size, per steradian); `bounds`
+/// is the box of `positions`.
+fn saved(positions: &[glam::Vec3], bounds: (DVec3, DVec3), triangles: &[[u32; 3]], starts: &[usize]) -> Vec<f64> {
     let clusters = starts.len() - 1;
-    let patches = Patches::of(positions, triangles, starts);
+    let patches = Patches::of(positions, bounds, triangles, starts);
     let mut saved = vec![0.0f64; clusters * clusters];
     let (mut over, mut under) = (vec![0.0f32; patches.len()], vec![0.0f32; patches.len()]);
     for p in 0..patches.len() {
@@ -151,10 +153,9 @@ struct Patches {
 }
 
 impl Patches {
-    fn of(positions: &[glam::Vec3], triangles: &[[u32; 3]], starts: &[usize]) -> Patches {
+    fn of(positions: &[glam::Vec3], (lo, hi): (DVec3, DVec3), triangles: &[[u32; 3]], starts: &[usize]) -> Patches {
         let per_patch = triangles.len().div_ceil(PATCHES).max(LEAST);
         // The frame: centred on the bounding box, its largest side scaled to 1.
-        let (lo, hi) = Framing::bounds_of(positions);
         let middle = (lo + hi) * 0.5;
         let unit = 1.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
         let mut patches = Patches {
@@ -251,7 +252,7 @@ mod tests {
         let triangles: Vec<[u32; 3]> = (0..40).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
         let starts = [0, 10, 25, 40];
         let scattered = [3..18, 30..35];
-        let regrouped = along_curve(&positions, &triangles, &starts, &scattered);
+        let regrouped = along_curve(&positions, Framing::bounds_of(&positions), &triangles, &starts, &scattered);
         let sorted = |ts: &[[u32; 3]]| {
             let mut ts = ts.to_vec();
             ts.sort_unstable();
@@ -303,7 +304,8 @@ mod tests {
         );
         let triangles = sphere.triangles_in_order(&order);
         let starts: Vec<usize> = (0..=8).map(|k| k * triangles.len() / 8).collect();
-        let alone = saved(&sphere.positions, &triangles, &starts).into_iter().fold(0.0, f64::max);
+        let bounds = Framing::bounds_of(&sphere.positions);
+        let alone = saved(&sphere.positions, bounds, &triangles, &starts).into_iter().fold(0.0, f64::max);
         // The same sphere with a copy at half the size inside it, as a ninth piece.
         let n = sphere.positions.len() as u32;
         let inner = sphere.positions.iter().map(|p| *p * 0.5);
@@ -311,7 +313,7 @@ mod tests {
         let inner = triangles.iter().map(|t| t.map(|v| v + n));
         let nested: Vec<[u32; 3]> = triangles.iter().copied().chain(inner).collect();
         let starts: Vec<usize> = starts.iter().copied().chain([2 * triangles.len()]).collect();
-        let inside = saved(&positions, &nested, &starts);
+        let inside = saved(&positions, Framing::bounds_of(&positions), &nested, &starts);
         let hidden = (0..8).map(|a| inside[a * 9 + 8]).fold(0.0, f64::max);
         assert!(alone < hidden / 1000.0, "the sphere alone {alone}, over the inner one {hidden}");
     }
