@@ -47,7 +47,7 @@ pub const COLUMNS: &[&str] = &[
 ];
 
 /// One measurement. Field order is the column order ([`COLUMNS`]); `None` writes an empty cell.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Row {
     pub experiment: String,
     pub model: String,
@@ -201,29 +201,13 @@ impl Context {
             experiment: self.experiment.clone(),
             model: model.to_string(),
             model_base: model_base(model, source),
-            model_triangles: 0,
-            model_vertices: 0,
-            clip: None,
-            level: None,
-            update: None,
-            method: String::new(),
-            method_name: String::new(),
-            peer: false,
             seed: self.seed,
             metric,
-            cache: None,
-            cache_kind: None,
-            cache_size: None,
-            views: None,
-            res: None,
-            view: None,
             backend: self.backend.clone(),
-            value: 0.0,
-            seconds: 0.0,
             machine: self.machine.clone(),
             commit: self.commit.clone(),
             triorder: env!("CARGO_PKG_VERSION"),
-            error: None,
+            ..Row::default()
         }
     }
 }
@@ -242,7 +226,7 @@ pub const ORDER_COLUMNS: &[&str] =
 
 /// One line of a drawing spec's orders file: a whole order, the triangle ids in draw order
 /// separated by spaces (one line per order keeps the file a seventh of one row per triangle).
-#[derive(Debug, Clone, Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
 pub struct OrderRow {
     pub model: String,
     /// Canonical method spec, as in the results CSV.
@@ -351,49 +335,12 @@ mod tests {
 
     #[test]
     fn header_matches_columns() {
-        let row = Row {
-            experiment: String::new(),
-            model: String::new(),
-            model_base: String::new(),
-            model_triangles: 0,
-            model_vertices: 0,
-            clip: None,
-            level: None,
-            update: None,
-            method: String::new(),
-            method_name: String::new(),
-            peer: false,
-            seed: 0,
-            metric: "acmr",
-            cache: None,
-            cache_kind: None,
-            cache_size: None,
-            views: None,
-            res: None,
-            view: None,
-            backend: String::new(),
-            value: 0.0,
-            seconds: 0.0,
-            machine: String::new(),
-            commit: String::new(),
-            triorder: "",
-            error: None,
-        };
+        let row = Row::default();
         let mut writer = csv::Writer::from_writer(Vec::new());
         writer.serialize(&row).unwrap();
         let text = String::from_utf8(writer.into_inner().unwrap()).unwrap();
         assert_eq!(text.lines().next().unwrap(), COLUMNS.join(","));
-        let order = OrderRow {
-            model: String::new(),
-            method: String::new(),
-            order: String::new(),
-            clusters: String::new(),
-            corners: String::new(),
-            overdraw: String::new(),
-            level: String::new(),
-            update: String::new(),
-            translucency: String::new(),
-        };
+        let order = OrderRow::default();
         let mut writer = csv::Writer::from_writer(Vec::new());
         writer.serialize(&order).unwrap();
         let text = String::from_utf8(writer.into_inner().unwrap()).unwrap();
