@@ -69,7 +69,7 @@
 //! `experiments/cheap-cuts-intel-tradeoff.toml` sweeps. Held out, one of the two main targets
 //! fails on five of seventeen meshes: OVR on Fox and RiggedFigure (all loose parts: the dot rule
 //! alone, 1.0231 and 1.0245 against meshoptimizer's 1.0209 and 1.0244), and FIFO-16 on spot
-//! (+1.5%), Xbot (+1.7%) and Michelle (+1.4%), whose cache order alone is 0.7–0.9% above
+//! (+1.4%), Xbot (+1.6%) and Michelle (+1.4%), whose cache order alone is 0.7–0.9% above
 //! meshopt-vcache's. Armadillo's OVR missed too (1.0483 against 1.0476) until step 7. Step 3 was
 //! added after those characters and Soldier showed what the greedy's fallback order cost them (mean
 //! OVR, ico:162 at 512²: Soldier 1.2383 to 1.1684, RobotExpressive 1.1777 to 1.0786, RiggedFigure
