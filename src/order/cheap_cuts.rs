@@ -409,6 +409,15 @@ impl Sequence {
         if best >= here {
             return false;
         }
+        self.move_to(a..=b, to);
+        true
+    }
+
+    /// Moves the pieces at `block` so that they start at `to` once moved (a place among the
+    /// others), keeping every piece's place current.
+    fn move_to(&mut self, block: RangeInclusive<usize>, to: usize) {
+        let (a, b) = (*block.start(), *block.end());
+        let len = b - a + 1;
         let range = if to < a {
             self.sequence[to..=b].rotate_right(len);
             to..=b
@@ -419,7 +428,6 @@ impl Sequence {
         for i in range {
             self.position[self.sequence[i] as usize] = i;
         }
-        true
     }
 
     /// Step 6: pieces that follow each other in the cache order put back together wherever that
@@ -489,10 +497,8 @@ impl Sequence {
         if change > 0 {
             return false;
         }
-        let run: Vec<u32> = self.sequence.drain(block.clone()).collect();
-        let to = if to > *block.start() { to - run.len() } else { to };
-        self.sequence.splice(to..to, run);
-        self.place();
+        let len = block.end() - block.start() + 1;
+        self.move_to(block.clone(), if to > *block.start() { to - len } else { to });
         true
     }
 }
