@@ -9,7 +9,7 @@
 //!
 //! The files here are the methods, except [`orders`] (what a method returns) and [`params`]
 //! (method specs); families that share helpers have a folder: `curves/` (snake, Hilbert),
-//! `meshopt/` (the peers), `mla/` and `nehab/` (their helpers beside them).
+//! `meshopt/` (the peers), `mla/`, `nehab/` and `cheap_cuts/` (their helpers beside them).
 
 pub mod levels;
 pub mod orders;
