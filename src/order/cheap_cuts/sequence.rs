@@ -143,17 +143,23 @@ impl Sequence {
         let others = self.sequence.len() - len;
         let mut passed = std::mem::take(&mut self.passed);
         passed.clear();
-        passed.resize(others, 0);
+        // One slot past the others' places takes the arcs inside the block, so that where a
+        // neighbour lies decides no branch (it is a coin toss).
+        passed.resize(others + 1, 0);
         for &piece in &self.sequence[a..=b] {
             for &(other, w) in &self.neighbours[piece as usize] {
                 let place = self.position[other as usize];
-                if place < a {
-                    passed[place] += w;
+                let at = if place < a {
+                    place
                 } else if place > b {
-                    passed[place - len] += w;
-                }
+                    place - len
+                } else {
+                    others
+                };
+                passed[at] += w;
             }
         }
+        passed.pop();
         let here: i64 = passed[..a].iter().sum();
         // The others' pieces in order, to skip the places between two that follow each other:
         // going there would break a succession.
