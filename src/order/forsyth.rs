@@ -209,6 +209,7 @@ fn live_mask(n: usize) -> u32 {
 /// best ones are those at a vertex with the fewest live triangles (both tables' boosts never rise
 /// with the count): the leftovers of the region just drawn, which the article's global search
 /// would also pick. Lowest bucket, newest entry first, so the jump is short.
+#[derive(Default)]
 struct Evicted {
     buckets: [Vec<(u32, u32)>; EVICTED_BUCKETS],
 }
@@ -219,6 +220,11 @@ const EVICTED_BUCKETS: usize = 8;
 impl Evicted {
     fn push(&mut self, vertex: u32, live: u32) {
         self.buckets[(live as usize).min(EVICTED_BUCKETS) - 1].push((vertex, live));
+    }
+
+    /// Forgets every entry: live counts restart with each run [`Redraw`] draws.
+    fn clear(&mut self) {
+        self.buckets.iter_mut().for_each(Vec::clear);
     }
 
     /// The current vertex with the fewest live triangles (newest first), removed from the list.
@@ -238,36 +244,140 @@ impl Evicted {
 /// `vertex_triangles` is their vertex→triangle adjacency (as [`crate::mesh::topology::vertex_triangles`]
 /// builds it).
 pub(crate) fn forsyth(triangles: &[[u32; 3]], vertex_triangles: &Csr, cache: usize, scores: Scores) -> Order {
-    let mut state = State::new(triangles, vertex_triangles, cache, scores);
-    let mut evicted = Evicted { buckets: Default::default() };
+    let mut walk = Walk { state: State::new(triangles, vertex_triangles, cache, scores), evicted: Evicted::default() };
     let mut order: Order = Vec::with_capacity(triangles.len());
     let mut cursor = 0usize;
-    let mut current = 0u32;
-    while (current as usize) < triangles.len() {
-        order.push(current);
-        state.draw(current);
-        let best = state.rescore(current);
-        let out = state.evicted();
-        for &Entry { vertex, .. } in out {
-            evicted.push(vertex, state.vertices[vertex as usize].live);
+    // A fresh component starts at the first triangle left in input order; past the last, none.
+    walk.draw_from(0, &mut order, |emitted| {
+        while cursor < emitted.len() && emitted[cursor] {
+            cursor += 1;
         }
-        let out = out.len();
-        current = match best {
-            NONE => match evicted.pop(&state.vertices) {
-                Some(v) => state.best_of(v),
-                None => {
-                    while cursor < triangles.len() && state.emitted[cursor] {
-                        cursor += 1;
-                    }
-                    cursor as u32
-                }
-            },
-            best => best,
-        };
-        state.settle(out);
-    }
+        cursor as u32
+    });
     order
 }
+
+/// The greedy loop's state and its store of evicted vertices.
+struct Walk<'a> {
+    state: State<'a>,
+    evicted: Evicted,
+}
+
+impl Walk<'_> {
+    /// Draws `first` and then the best triangle after each, appending them to `order`, until
+    /// neither the cache nor the evicted vertices have a live triangle and `fallback` (given the
+    /// drawn flags) names none: a number from the triangle count up.
+    fn draw_from(&mut self, first: u32, order: &mut Order, mut fallback: impl FnMut(&[bool]) -> u32) {
+        let Walk { state, evicted } = self;
+        let mut current = first;
+        while (current as usize) < state.triangles.len() {
+            order.push(current);
+            state.draw(current);
+            let best = state.rescore(current);
+            let out = state.evicted();
+            for &Entry { vertex, .. } in out {
+                evicted.push(vertex, state.vertices[vertex as usize].live);
+            }
+            let out = out.len();
+            current = match best {
+                NONE => match evicted.pop(&state.vertices) {
+                    Some(v) => state.best_of(v),
+                    None => fallback(&state.emitted),
+                },
+                best => best,
+            };
+            state.settle(out);
+        }
+    }
+}
+
+/// Forsyth's greedy run by run (`cheap-cuts`' step 8): each run of triangles is drawn over its
+/// own triangles only, every vertex's valence counting its triangles in the run, and starts from
+/// the LRU that the triangles drawn before it left, so that a run drawn after a neighbour on the
+/// surface starts along their shared border instead of cold where the cache order cut it.
+pub(crate) struct Redraw<'a> {
+    walk: Walk<'a>,
+}
+
+impl<'a> Redraw<'a> {
+    /// For redrawing the runs of `in_order` in its order: `in_order` lists every triangle once,
+    /// run after run, and `vertex_triangles` is the triangles' adjacency.
+    pub(crate) fn new(
+        triangles: &'a [[u32; 3]],
+        vertex_triangles: &Csr,
+        in_order: &[u32],
+        cache: usize,
+        scores: Scores,
+    ) -> Redraw<'a> {
+        // Each row lists its triangles run after run, so that a run's entries are one segment of
+        // the row; a vertex's live part is its current run's segment, and nothing is live yet.
+        let adjacency = vertex_triangles.reordered(triangles, in_order);
+        let mut state = State::new(triangles, &adjacency, cache, scores);
+        state.vertices.iter_mut().for_each(|v| v.live = 0);
+        Redraw { walk: Walk { state, evicted: Evicted::default() } }
+    }
+
+    /// Appends to `order` the triangles of `run`, the next run, in Forsyth's greedy order from the
+    /// LRU left by `drawn` (every triangle drawn before, in order, whichever order was kept).
+    ///
+    /// The LRU is rebuilt from `drawn`'s tail: each triangle put its corners in front, so walking
+    /// back, each triangle's corners not met yet take the next places. The walk stops at
+    /// [`SEED_REACH`] × `cache` triangles, which only many repeated triangles over few vertices
+    /// reach; the LRU is then seeded short, which only moves where the run starts.
+    pub(crate) fn redraw(&mut self, run: &[u32], drawn: &[u32], order: &mut Order) {
+        let Walk { state, evicted } = &mut self.walk;
+        let triangles = state.triangles;
+        // Each vertex's valence and score follow its count up; the last corner leaves them right.
+        for &t in run {
+            for v in triangles[t as usize] {
+                let vertex = &mut state.vertices[v as usize];
+                vertex.live += 1;
+                vertex.valence = state.live_score[vertex.live as usize];
+                state.score[v as usize] = vertex.valence;
+            }
+        }
+        let mut cached: Vec<u32> = Vec::with_capacity(state.cache);
+        for &t in drawn.iter().rev().take(SEED_REACH * state.cache) {
+            for v in triangles[t as usize] {
+                if cached.len() < state.cache && !cached.contains(&v) {
+                    cached.push(v);
+                }
+            }
+            if cached.len() == state.cache {
+                break;
+            }
+        }
+        let listed = cached.iter().enumerate().filter(|&(_, &v)| state.vertices[v as usize].live > 0);
+        state.next_len = 0;
+        for (place, &vertex) in listed {
+            state.next[state.next_len] = Entry { vertex, place: place as u32 };
+            state.next_len += 1;
+        }
+        let best = state.score_listed();
+        state.settle(0);
+        evicted.clear();
+        let mut cursor = 0;
+        // With nothing cached in the run, it starts where the cache order started it; after a
+        // dead end, at the first of its triangles left in that order.
+        let first = if best == NONE { run[0] } else { best };
+        self.walk.draw_from(first, order, |emitted| {
+            while cursor < run.len() && emitted[run[cursor] as usize] {
+                cursor += 1;
+            }
+            run.get(cursor).copied().unwrap_or(NONE)
+        });
+        // The run's segments are drawn: each row's live part moves on to the next run's.
+        let state = &mut self.walk.state;
+        for &t in run {
+            for v in triangles[t as usize] {
+                state.vertices[v as usize].start += 1;
+            }
+        }
+    }
+}
+
+/// How far back, in triangles per LRU entry, [`Redraw::redraw`] seeks the cached vertices.
+const SEED_REACH: usize = 4;
 
 /// Everything the greedy loop updates, so that each step's work is a method with only what it
 /// needs in registers.
@@ -405,7 +515,7 @@ impl<'a> State<'a> {
     /// loops get the registers.
     #[inline(never)]
     fn rescore(&mut self, drawn: u32) -> u32 {
-        let State { triangles, adjacent, vertices, place_score, score, lru, next, candidates, .. } = self;
+        let State { triangles, vertices, lru, next, .. } = self;
         let [a, b, c] = triangles[drawn as usize];
         let distinct = [true, b != a, c != a && c != b];
         let k = distinct.iter().filter(|&&d| d).count() as u32;
@@ -429,6 +539,15 @@ impl<'a> State<'a> {
             shift -= u32::from(corner);
         }
         self.next_len = len;
+        self.score_listed()
+    }
+
+    /// Re-scores the vertices listed in `next` and returns the best of their live triangles (the
+    /// first on ties, in list order; [`NONE`] if there are none).
+    #[inline(always)]
+    fn score_listed(&mut self) -> u32 {
+        let State { triangles, adjacent, vertices, place_score, score, next, candidates, .. } = self;
+        let len = self.next_len;
         // Each listed vertex re-scored, and its row's live part appended to the candidates, copied
         // in whole chunks: a chunk's tail beyond the live part is overwritten by the next row, so
         // no row's length decides a branch, and the scoring below is one loop (one mispredicted

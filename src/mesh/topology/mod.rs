@@ -52,6 +52,24 @@ impl Csr {
         &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
 
+    /// This vertex→triangle adjacency of `triangles` with each row listing its triangles in the
+    /// order they come in `order` (a permutation of the triangles' ids), once per corner as
+    /// before: for a walk over `order`'s runs that wants each run's entries together in a row.
+    /// The rows keep their lengths, so only the items are placed, in one pass.
+    pub fn reordered(&self, triangles: &[[u32; 3]], order: &[u32]) -> Csr {
+        debug_assert_eq!(3 * order.len(), self.items.len());
+        let mut cursor = self.offsets.clone();
+        let mut items = vec![0u32; self.items.len()];
+        for &t in order {
+            for v in triangles[t as usize] {
+                let at = &mut cursor[v as usize];
+                items[*at as usize] = t;
+                *at += 1;
+            }
+        }
+        Csr { offsets: self.offsets.clone(), items }
+    }
+
     pub fn rows(&self) -> usize {
         self.offsets.len() - 1
     }
@@ -259,6 +277,11 @@ mod tests {
         assert_eq!(vertex_triangles(&m), expected);
         assert_eq!(expected.row(3), &[0, 1, 1, 3]);
         assert_eq!(expected.row(5), &[] as &[u32]);
+        // Reordered, each row lists the same triangles in the new order's order.
+        let order = [2, 0, 3, 1];
+        let pairs = order.iter().flat_map(|&t| m.triangles[t as usize].map(|v| (v, t)));
+        assert_eq!(expected.reordered(&m.triangles, &order), Csr::from_pairs(m.vertex_count(), pairs));
+        assert_eq!(expected.reordered(&m.triangles, &order).row(3), &[0, 3, 1, 1]);
     }
 
     #[test]
