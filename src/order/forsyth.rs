@@ -706,6 +706,46 @@ mod tests {
         }
     }
 
+    /// Redrawn as one run, a mesh comes out in exactly `forsyth`'s order (the same walk, seeded
+    /// with nothing); cut into runs drawn in another sequence, on a fan (rows longer than a chunk)
+    /// with degenerate triangles, each run comes back with its own triangles, each once, and a run
+    /// that shares a vertex with the one before it starts at a triangle on that vertex.
+    #[test]
+    fn redraw_draws_each_run_over_its_own_triangles() {
+        let sphere = procedural::generate("sphere:2000", 3).unwrap().unwrap();
+        let adjacency = vertex_triangles(&sphere);
+        let all: Vec<u32> = (0..sphere.triangle_count() as u32).collect();
+        for cache in [4, 20, 32] {
+            let mut redraw = Redraw::new(&sphere.triangles, &adjacency, &all, cache, Scores::Tuned);
+            let mut order = Vec::new();
+            redraw.redraw(&all, &[], &mut order);
+            assert_eq!(order, forsyth(&sphere.triangles, &adjacency, cache, Scores::Tuned), "cache {cache}");
+        }
+
+        let rim = 40u32;
+        let mut triangles: Vec<[u32; 3]> = (0..rim).map(|i| [0, 1 + i, 1 + (i + 1) % rim]).collect();
+        triangles.splice(7..7, [[0, 0, 5], [3, 3, 3], [0, 9, 0]]);
+        let positions = (0..=rim).map(|i| glam::Vec3::new(i as f32, (i * i) as f32, 0.0)).collect();
+        let fan = crate::mesh::Mesh::new("fan", positions, triangles, Default::default()).unwrap();
+        let ids: Vec<u32> = (0..fan.triangle_count() as u32).collect();
+        let runs: Vec<&[u32]> = vec![&ids[30..], &ids[..12], &ids[12..30]];
+        let in_order = runs.concat();
+        let mut redraw = Redraw::new(&fan.triangles, &vertex_triangles(&fan), &in_order, 8, Scores::Tuned);
+        let mut order = Vec::new();
+        for run in &runs {
+            let start = order.len();
+            let drawn = order.clone();
+            redraw.redraw(run, &drawn, &mut order);
+            let mut got = order[start..].to_vec();
+            got.sort_unstable();
+            assert_eq!(got, run.to_vec());
+            // Every run here shares the hub, vertex 0, with the triangles drawn before it.
+            if start > 0 {
+                assert!(fan.triangles[order[start] as usize].contains(&0), "run from {start} started cold");
+            }
+        }
+    }
+
     /// The article's values, written out: 0.75 for the last triangle, 1 at place 3 decaying to 0
     /// at place 32, and `2/√live`.
     #[test]
