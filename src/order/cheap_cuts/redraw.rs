@@ -63,7 +63,8 @@ struct Fifo<'a> {
     stamp: Vec<u32>,
     misses: u32,
     size: u32,
-    /// The stamps and count the trial in progress overwrote, to take them back.
+    /// The stamps the trial in progress overwrote, and the count before it: what
+    /// [`Fifo::undo`] puts back.
     undo: Vec<(u32, u32)>,
     before: u32,
 }
@@ -128,8 +129,8 @@ mod tests {
         }
     }
 
-    /// Every run comes back with its own triangles, each once, the runs in their sequence; and
-    /// where the cache order's slice misses less, it is kept as it was.
+    /// Every run comes back with its own triangles, each once, the runs in their sequence; and no
+    /// run's kept order misses more in the FIFO than its slice of the cache order would have.
     #[test]
     fn runs_keep_their_triangles_and_their_sequence() {
         let mesh = procedural::generate("sphere:4000", 9).unwrap().unwrap();
