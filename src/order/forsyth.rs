@@ -292,9 +292,9 @@ impl Walk<'_> {
 }
 
 /// Forsyth's greedy run by run (`cheap-cuts`' step 8): each run of triangles is drawn over its
-/// own triangles only, every vertex's valence counting its triangles in the run, and starts from
-/// the LRU that the triangles drawn before it left, so that a run drawn after a neighbour on the
-/// surface starts along their shared border instead of cold where the cache order cut it.
+/// own triangles only, every vertex's valence counting its triangles in the run, from the LRU
+/// that the triangles drawn before it left (so a run drawn after a neighbour on the surface
+/// starts on a vertex they share).
 pub(crate) struct Redraw<'a> {
     walk: Walk<'a>,
 }

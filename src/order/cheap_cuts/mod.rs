@@ -55,12 +55,12 @@
 //!    from 0.34 to 0.61 points. Moving single pieces instead, before step 6, lowered the
 //!    overdraw more but broke successions (FIFO-16 up 0.2–0.3%; smallest margin 0.58–0.60), and
 //!    was dropped.
-//! 8. **Runs redrawn warm** ([`redraw_runs`]): a run that does not follow its predecessor in the
-//!    cache order starts cold where it was cut, but the run drawn before it is often its
-//!    neighbour on the surface. Each run is redrawn by Forsyth's greedy (`lru`, tuned table)
-//!    over its own triangles, from the cache the runs before it left, so that it starts along
-//!    the shared border; it keeps whichever of that and its slice of the cache order misses less
-//!    in the FIFO of `cache` entries. The runs' sequence is unchanged. Added after the held-out
+//! 8. **Runs redrawn** ([`redraw_runs`]): a run's slice of the cache order was drawn by a greedy
+//!    that counted the triangles of the pieces around it and started from a cache the cut has
+//!    emptied. Each run is redrawn by Forsyth's greedy (`lru`, tuned table) over its own
+//!    triangles, from the cache the runs before it left (almost always none of its vertices), so
+//!    that its border vertices are finished inside it; it keeps whichever of that and its slice
+//!    misses less in the FIFO of `cache` entries. The runs' sequence is unchanged. Added after the held-out
 //!    FIFO-16 misses below, with no parameter of its own and the defaults not tuned again; see
 //!    **Tuning** for what it changed and what was tried on the way.
 //!
@@ -81,8 +81,8 @@
 //! (1.0483 against 1.0476) until step 7, and FIFO-16 on Xbot (+1.6%) and Michelle (+1.4%) until
 //! step 8 (now +0.97% and +0.77%; spot's was +1.45%). Step 8 came from those misses: of three
 //! variants measured on the 18 welded meshes, redrawing every run lowered the smallest margin to
-//! the targets on the tuning models from 0.61 to 0.20 points (a run redrawn alone loses more
-//! inside than it gains at its start); keeping the better order per run raised it to 0.62, the
+//! the targets on the tuning models from 0.61 to 0.20 points (FIFO-16 rose on most meshes: the
+//! slice is the better order of some runs); keeping the better order per run raised it to 0.62, the
 //! same whether a dead end resumes at the run's first triangle left or, as kept, by Forsyth's
 //! own rule (the former would have passed spot: +0.97%). It gave up a little of Intel's FIFO 128
 //! (bun_zipper 3.0% to 3.6% above the best), and brought Xbot's AMD within 2%. Step 3 was
