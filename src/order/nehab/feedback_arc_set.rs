@@ -15,8 +15,8 @@
 //!
 //! Each node is picked by one linear scan of the nodes left, O(V² + E) in all: the graphs here
 //! have at most a few thousand nodes (clusters), where that is milliseconds and simpler than
-//! bucket queues (one scan for the three picks instead of three: 1.2 to 0.4 ms on Xbot's 282
-//! pieces in `cheap-cuts`, the same orders).
+//! bucket queues (one scan for the three picks instead of three: 1.2 to 0.4–0.7 ms on Xbot's 282
+//! pieces in `cheap-cuts`, 2.6 to 1.0–1.2 ms on BrainStem's 429, the same orders).
 
 use super::overdraw_graph::Arc;
 
