@@ -102,8 +102,8 @@
 //! higher on three layered characters (lower on Soldier and CesiumMan), still below
 //! meshopt-overdraw's there (`experiments/cheap-cuts-graphs.toml`). A mesh no cut fits
 //! (RiggedSimple) is one piece, returned without a graph. Step 8 is a second Forsyth pass: it
-//! made cheap-cuts 1.3–1.6× slower on the meshes it cuts, 1.23–2.81× meshopt-overdraw's time at
-//! `c0b64bd` (Xbot highest, then BrainStem at 2.60×).
+//! made cheap-cuts 1.3–1.6× slower on the meshes it cuts: 1.20–2.74× meshopt-overdraw's time at
+//! `63dd992` (Xbot highest, then BrainStem at 2.51×).
 
 use std::ops::Range;
 
