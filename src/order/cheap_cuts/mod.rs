@@ -59,10 +59,11 @@
 //!    that counted the triangles of the pieces around it and started from a cache the cut has
 //!    emptied. Each run is redrawn by Forsyth's greedy (`lru`, tuned table) over its own
 //!    triangles, from the cache the runs before it left (almost always none of its vertices), so
-//!    that its border vertices are finished inside it; it keeps whichever of that and its slice
-//!    misses less in the FIFO of `cache` entries. The runs' sequence is unchanged. Added after the held-out
-//!    FIFO-16 misses below, with no parameter of its own and the defaults not tuned again; see
-//!    **Tuning** for what it changed and what was tried on the way.
+//!    that its border vertices are finished inside it; it keeps that where it misses no more
+//!    than its slice in any costed FIFO (`cache`, and 128 with `far` below 1). The runs' sequence
+//!    is unchanged. Added after the held-out FIFO-16 misses below, with no parameter of its own
+//!    and the defaults not tuned again; see **Tuning** for what it changed and what was tried on
+//!    the way.
 //!
 //! **Tuning, and what it costs.** The defaults were chosen on five models only: bun_zipper,
 //! dragon_vrip_res3, feline, horse and rocker-arm (the rest are held out; spot and
@@ -281,7 +282,8 @@ impl Ordering for CheapCuts {
             .chunk_by(|&a, &b| b == a + 1)
             .map(|run| &order[starts[run[0] as usize]..starts[run[run.len() - 1] as usize + 1]])
             .collect();
-        Ok(redraw_runs(&mesh.triangles, &scene.topology.vertex_triangles, &runs, self.lru, self.cache).into())
+        let costed: Vec<u32> = caches[..costs.len()].iter().map(|&(size, _)| size).collect();
+        Ok(redraw_runs(&mesh.triangles, &scene.topology.vertex_triangles, &runs, self.lru, &costed).into())
     }
 }
 
