@@ -182,19 +182,19 @@ const LRU: ParamInfo = ParamInfo {
     name: "lru",
     default: "20",
     kind: ParamKind::Int { min: 4, max: 1024 },
-    help: "LRU size the Forsyth scores model",
+    help: "LRU size the Forsyth scores model, in the cache order and in each run's redraw",
 };
 
 const CACHE: ParamInfo = ParamInfo {
     name: "cache",
     default: "16",
     kind: ParamKind::Int { min: 3, max: 1024 },
-    help: "FIFO size whose hits the cuts are costed in",
+    help: "FIFO size whose hits the cuts are costed in, and each run's order (redrawn or not) chosen by",
 };
 
 pub static METHOD: Method = Method {
     name: "cheap-cuts",
-    summary: "ours: Forsyth order cut where the FIFO loses least, pieces (and loose parts) ordered for overdraw",
+    summary: "ours: Forsyth order cut where the FIFO loses least, pieces (and loose parts) ordered for overdraw, runs redrawn",
     source: "ours (issue 19); graph and ordering after Nehab, Barczak & Sander 2006, §4-5",
     peer: false,
     per_node: false,
