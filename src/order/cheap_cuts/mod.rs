@@ -86,7 +86,7 @@
 //! slice is the better order of some runs); keeping the better order per run raised it to 0.62, the
 //! same whether a dead end resumes at the run's first triangle left or, as kept, by Forsyth's
 //! own rule (the former would have passed spot: +0.97%). It gave up a little of Intel's FIFO 128
-//! (bun_zipper 3.0% to 3.6% above the best), and brought Xbot's AMD within 2%. Step 3 was
+//! (armadillo 4.8% to 5.5% above the best), and brought Xbot's AMD within 2%. Step 3 was
 //! added after those characters and Soldier showed what the greedy's fallback order cost them (mean
 //! OVR, ico:162 at 512²: Soldier 1.2383 to 1.1684, RobotExpressive 1.1777 to 1.0786, RiggedFigure
 //! 1.0772 to 1.0245, Fox 1.0420 to 1.0231; on the tuning models at most 0.0002; all before step
