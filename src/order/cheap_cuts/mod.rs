@@ -455,11 +455,17 @@ fn turning(positions: &[Vec3], triangles: &[[u32; 3]], order: &[u32], window: us
         prefix.push(prefix.last().unwrap() + (b - a).cross(c - a));
     }
     let n = order.len();
+    // The normal of the window that ends at each position, normalized once: it is the `before`
+    // of that position and the `after` of the one a window earlier.
+    let ending: Vec<DVec3> =
+        (0..=n).map(|end| (prefix[end] - prefix[end.saturating_sub(window)]).normalize_or_zero()).collect();
     (0..n)
         .map(|i| {
-            let before = prefix[i] - prefix[i.saturating_sub(window)];
-            let after = prefix[(i + window).min(n)] - prefix[i];
-            ((1.0 - before.normalize_or_zero().dot(after.normalize_or_zero())) * 1024.0).round() / 1024.0
+            let after = match ending.get(i + window) {
+                Some(&after) => after,
+                None => (prefix[n] - prefix[i]).normalize_or_zero(),
+            };
+            ((1.0 - ending[i].dot(after)) * 1024.0).round() / 1024.0
         })
         .collect()
 }
