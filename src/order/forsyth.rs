@@ -294,7 +294,8 @@ impl Walk<'_> {
 /// Forsyth's greedy run by run (`cheap-cuts`' step 8): each run of triangles is drawn over its
 /// own triangles only, every vertex's valence counting its triangles in the run, from the LRU
 /// that the triangles drawn before it left (so a run drawn after a neighbour on the surface
-/// starts on a vertex they share).
+/// starts on a vertex they share), or, with none of its vertices there, from its best-scoring
+/// triangle.
 pub(crate) struct Redraw<'a> {
     walk: Walk<'a>,
 }
@@ -357,9 +358,14 @@ impl<'a> Redraw<'a> {
         state.settle(0);
         evicted.clear();
         let mut cursor = 0;
-        // With nothing cached in the run, it starts where the cache order started it; after a
-        // dead end, at the first of its triangles left in that order.
-        let first = if best == NONE { run[0] } else { best };
+        // With nothing of the run cached, it starts at its best-scoring triangle, as the article
+        // does when the cache offers nothing: scored by valence alone, a triangle at a vertex
+        // with the fewest of the run's triangles, on its border. (It started at the run's first
+        // triangle in the cache order until `cheap-cuts`' held-out misses were looked at again:
+        // see its module.) After a dead end that the evicted vertices do not resume, at the first
+        // of its triangles left in the cache order: a search of the run at every such dead end
+        // would make a run of many small parts quadratic.
+        let first = if best == NONE { self.walk.state.best_among(run) } else { best };
         self.walk.draw_from(first, order, |emitted| {
             while cursor < run.len() && emitted[run[cursor] as usize] {
                 cursor += 1;
@@ -469,8 +475,13 @@ impl<'a> State<'a> {
     /// The best-scoring live triangle of vertex `v` (the first on ties).
     fn best_of(&self, v: u32) -> u32 {
         let Vertex { start, live, .. } = self.vertices[v as usize];
-        let row = &self.adjacent[start as usize..(start + live) as usize];
-        row.iter()
+        self.best_among(&self.adjacent[start as usize..(start + live) as usize])
+    }
+
+    /// The best-scoring of `candidates` (the first on ties; [`NONE`] if there are none).
+    fn best_among(&self, candidates: &[u32]) -> u32 {
+        candidates
+            .iter()
             .fold((NONE, f32::NEG_INFINITY), |best, &t| {
                 let score = triangle_score(self.triangles, &self.score, t);
                 if score > best.1 { (t, score) } else { best }
@@ -606,11 +617,14 @@ impl<'a> State<'a> {
     }
 }
 
-/// The sum of the scores of adjacency entry `t`'s corners, in corner order.
+/// The sum of the scores of triangle `t`'s corners, in corner order: `t` an adjacency entry, or
+/// a triangle of the run [`Redraw::redraw`] draws.
 #[inline(always)]
 fn triangle_score(triangles: &[[u32; 3]], score: &[f32], t: u32) -> f32 {
     // SAFETY: `t` is an adjacency entry, which `State::new` checked is a triangle of
-    // `triangles`, whose corners it checked are vertices of `score`.
+    // `triangles`, whose corners it checked are vertices of `score`; or a triangle of the run
+    // being redrawn, which `Redraw::redraw` first indexed into `triangles`, and its corners into
+    // the vertices, with bounds checks.
     unsafe {
         let [a, b, c] = *triangles.get_unchecked(t as usize);
         score.get_unchecked(a as usize) + score.get_unchecked(b as usize) + score.get_unchecked(c as usize)
@@ -706,20 +720,36 @@ mod tests {
         }
     }
 
-    /// Redrawn as one run, a mesh comes out in exactly `forsyth`'s order (the same walk, seeded
-    /// with nothing); cut into runs drawn in another sequence, on a fan (rows longer than a chunk)
-    /// with degenerate triangles, each run comes back with its own triangles, each once, and a run
-    /// that shares a vertex with the one before it starts at a triangle on that vertex.
+    /// The run's triangle with the highest sum of its corners' valence boosts, valences counted in
+    /// the run (the first on ties): where a run with nothing cached starts.
+    fn best_by_valence(triangles: &[[u32; 3]], run: &[u32]) -> u32 {
+        let mut count = std::collections::HashMap::new();
+        run.iter().flat_map(|&t| triangles[t as usize]).for_each(|v| *count.entry(v).or_insert(0usize) += 1);
+        let score = |t: u32| triangles[t as usize].iter().map(|v| Scores::Tuned.boost(count[v])).sum::<f32>();
+        run.iter().copied().reduce(|best, t| if score(t) > score(best) { t } else { best }).unwrap()
+    }
+
+    /// Redrawn as one run, a mesh comes out in exactly `forsyth`'s order once its triangles are
+    /// listed from the one a run with nothing cached starts at (the same walk, seeded with
+    /// nothing): on a grid that is a corner, not the first triangle. Cut into runs drawn in
+    /// another sequence, on a fan (rows longer than a chunk) with degenerate triangles, each run
+    /// comes back with its own triangles, each once; a run that shares a vertex with the one before
+    /// it starts at a triangle on that vertex, and one that shares none at its best-scoring one.
     #[test]
     fn redraw_draws_each_run_over_its_own_triangles() {
-        let sphere = procedural::generate("sphere:2000", 3).unwrap().unwrap();
-        let adjacency = vertex_triangles(&sphere);
-        let all: Vec<u32> = (0..sphere.triangle_count() as u32).collect();
-        for cache in [4, 20, 32] {
-            let mut redraw = Redraw::new(&sphere.triangles, &adjacency, &all, cache, Scores::Tuned);
-            let mut order = Vec::new();
-            redraw.redraw(&all, &[], &mut order);
-            assert_eq!(order, forsyth(&sphere.triangles, &adjacency, cache, Scores::Tuned), "cache {cache}");
+        for spec in ["sphere:2000", "grid:16x8"] {
+            let mut mesh = procedural::generate(spec, 3).unwrap().unwrap();
+            let all: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
+            let first = best_by_valence(&mesh.triangles, &all);
+            assert!(spec != "grid:16x8" || first != 0, "the grid's best triangle is its first: nothing tested");
+            mesh.triangles.rotate_left(first as usize);
+            let adjacency = vertex_triangles(&mesh);
+            for cache in [4, 20, 32] {
+                let mut redraw = Redraw::new(&mesh.triangles, &adjacency, &all, cache, Scores::Tuned);
+                let mut order = Vec::new();
+                redraw.redraw(&all, &[], &mut order);
+                assert_eq!(order, forsyth(&mesh.triangles, &adjacency, cache, Scores::Tuned), "{spec} cache {cache}");
+            }
         }
 
         let rim = 40u32;
@@ -728,7 +758,9 @@ mod tests {
         let positions = (0..=rim).map(|i| glam::Vec3::new(i as f32, (i * i) as f32, 0.0)).collect();
         let fan = crate::mesh::Mesh::new("fan", positions, triangles, Default::default()).unwrap();
         let ids: Vec<u32> = (0..fan.triangle_count() as u32).collect();
-        let runs: Vec<&[u32]> = vec![&ids[30..], &ids[..12], &ids[12..30]];
+        // The first run listed from inside it: where the cache order would have started it.
+        let inside: Vec<u32> = ids[35..].iter().chain(&ids[30..35]).copied().collect();
+        let runs: Vec<&[u32]> = vec![&inside, &ids[..12], &ids[12..30]];
         let in_order = runs.concat();
         let mut redraw = Redraw::new(&fan.triangles, &vertex_triangles(&fan), &in_order, 8, Scores::Tuned);
         let mut order = Vec::new();
@@ -736,12 +768,17 @@ mod tests {
             let start = order.len();
             let drawn = order.clone();
             redraw.redraw(run, &drawn, &mut order);
-            let mut got = order[start..].to_vec();
+            let (mut got, mut want) = (order[start..].to_vec(), run.to_vec());
             got.sort_unstable();
-            assert_eq!(got, run.to_vec());
-            // Every run here shares the hub, vertex 0, with the triangles drawn before it.
+            want.sort_unstable();
+            assert_eq!(got, want);
+            // Every run here but the first shares the hub, vertex 0, with the triangles drawn
+            // before it.
             if start > 0 {
                 assert!(fan.triangles[order[start] as usize].contains(&0), "run from {start} started cold");
+            } else {
+                assert_eq!(order[0], best_by_valence(&fan.triangles, run));
+                assert_ne!(order[0], run[0], "the run's best triangle is its first: nothing tested");
             }
         }
     }
