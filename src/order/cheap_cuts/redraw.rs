@@ -11,7 +11,8 @@
 //! from the cache that is really there: empty for almost every run, as the run drawn before is
 //! seldom a neighbour on the surface (scratch counters at `23ae6af`: 1 of 222 runs on Xbot, 2 of
 //! 243 on BrainStem, 17 of 118 on bun_zipper and 15 of 153 on horse start with one of their own
-//! vertices cached), and otherwise on a vertex the two share. Each run keeps the redrawn order
+//! vertices cached), so it starts at its best-scoring triangle, on its border; otherwise on a
+//! vertex the two share. Each run keeps the redrawn order
 //! where it misses no more than the slice, given what the runs before it left there, in every
 //! FIFO the cuts were costed in: the `cache` entries, and Intel's 128 when `far` holds the cuts
 //! to it (the redrawn one on 189 of 222 runs on Xbot, 67 of 118 on bun_zipper, at the defaults).
