@@ -82,9 +82,8 @@
 //! meshoptimizer's mesh centre, the mean of the index buffer's vertex positions, instead of the
 //! area-weighted centroid, they come out at exactly meshoptimizer's values, and RobotExpressive
 //! worse, 1.0809 against 1.0786: not adopted, as only held-out meshes tell the two apart).
-//! Armadillo's OVR missed
-//! too (1.0483 against 1.0476) until step 7, FIFO-16 on Xbot (+1.6%) and Michelle (+1.4%) until
-//! step 8, and FIFO-16 on spot (+1.45%, +1.07% after step 8; its cache order alone is 0.7% above
+//! Armadillo's OVR missed too (1.0483 against 1.0476) until step 7, FIFO-16 on Xbot (+1.6%) and
+//! Michelle (+1.4%) until step 8, and FIFO-16 on spot (+1.45%, +1.07% after step 8; its cache order alone is 0.7% above
 //! meshopt-vcache's) until a run redrawn from a cache holding none of its vertices began to start
 //! at its best-scoring triangle (now +0.70%, and Xbot +0.68%, Michelle +0.49%). Step 8 came from
 //! those misses: of three variants measured on the 18 welded meshes, redrawing every run lowered
@@ -100,9 +99,8 @@
 //! walk, with the held-out results seen. A mesh no cut fits, one piece, was returned as its cache
 //! order until then; it is one run, and is now redrawn like any other (decided for that reason
 //! before RiggedSimple, the one such shared mesh, was measured, though in the hope that it would
-//! help there, as it did; no tuning model is one piece).
-//! Step 8 gave up a little of Intel's FIFO 128 (armadillo 4.8% to 5.5% above the best), and
-//! brought Xbot's AMD within 2%. Step 3 was
+//! help there, as it did; no tuning model is one piece). Step 8 gave up a little of Intel's FIFO
+//! 128 (armadillo 4.8% to 5.5% above the best), and brought Xbot's AMD within 2%. Step 3 was
 //! added after those characters and Soldier showed what the greedy's fallback order cost them (mean
 //! OVR, ico:162 at 512²: Soldier 1.2383 to 1.1684, RobotExpressive 1.1777 to 1.0786, RiggedFigure
 //! 1.0772 to 1.0245, Fox 1.0420 to 1.0231; on the tuning models at most 0.0002; all before step
