@@ -323,7 +323,18 @@ impl Column {
         match (self, measure::names().find(|m| m.name == cell)) {
             (Column::Plain(_), Some(m)) => m.label.to_string(),
             (Column::Source(_, key), _) if !cell.is_empty() => format!("{key}={cell}"),
-            (Column::Joined(parts), _) => parts.iter().map(|c| c.label(record)).collect::<Vec<_>>().join(", "),
+            // Among other columns a bare parameter value says nothing of what it sets, and a part
+            // that is empty (a method without the parameter) is left out.
+            (Column::Joined(parts), _) => parts
+                .iter()
+                .filter_map(|c| match c {
+                    Column::Param(_, name) => {
+                        Some(c.cell(record)).filter(|v| !v.is_empty()).map(|v| format!("{name}={v}"))
+                    }
+                    _ => Some(c.label(record)).filter(|v| !v.is_empty()),
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
             _ => cell,
         }
     }
@@ -468,6 +479,15 @@ mod tests {
                 .to_vec();
         assert_eq!(display_names(&specs), ["random", "tipsify cache=8", "tipsify cache=16", "hoppe"]);
         assert_eq!(display_names(&["nehab".to_string()]), ["nehab"]);
+    }
+
+    /// A joined legend names a parameter with its value, and leaves out a method without it.
+    #[test]
+    fn joined_labels_name_parameters_and_skip_empty_parts() {
+        let series = Column::Joined(vec![Column::Plain(0), Column::Param(1, "cache".into())]);
+        let label = |name: &str, spec: &str| series.label(&StringRecord::from(vec![name, spec]));
+        assert_eq!(label("cheap-cuts", "cheap-cuts:budget=0.02,cache=128"), "cheap-cuts, cache=128");
+        assert_eq!(label("meshopt-overdraw", "meshopt-overdraw:threshold=1.05"), "meshopt-overdraw");
     }
 
     #[test]
