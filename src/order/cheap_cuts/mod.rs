@@ -40,8 +40,8 @@
 //!    pieces cut into patches of consecutive triangles, each pair weighed by the area one hides of
 //!    the other, integrated over view directions); with `graph=views` it is counted exactly, one
 //!    raster pass per view ([`one_pass`]), over `views` icosahedral views at `res`². The defaults
-//!    below were tuned with the views; the estimate replaced them afterwards, with nothing tuned
-//!    for it (see **Time**).
+//!    below were first tuned with the views; the estimate replaced them afterwards, with nothing
+//!    tuned for it (see **Time**), and the retuning for Intel's FIFO (see **Tuning**) used it.
 //! 6. **Successions kept** ([`Sequence::keep_successions`]): pieces that follow each other in the
 //!    cache order are drawn together again wherever that puts no more arc weight backward, so
 //!    those cuts cost no cache hits after all. Added after the tuning below, with no parameter of
@@ -82,7 +82,7 @@
 //! there before step 6 (still 2–9% below meshopt-overdraw), 3.1–3.6% on the tuning models at
 //! the end, and holding it within 2% with `far` cost the overdraw that beats meshopt-overdraw.
 //! **Retuning for Intel's FIFO** (2026-12-06, `572fa2d`): pricing the cuts in that FIFO itself,
-//! `cache=128`, had not been tried. On the five tuning models a grid of `cache` 128 or 192 ×
+//! `cache=128`, had not been tried. On the five tuning models, with the estimated graph, a grid of `cache` 128 or 192 ×
 //! `budget` 0.015, 0.02, 0.025 or 0.03 × `lru` 20, 24 or 28 × `min` 48, 64 or 96 was measured,
 //! and the setting with the largest smallest margin to all five targets (in points of each
 //! target, against the best of cheap-cuts' peers) taken: `cache` 128, `budget` 0.02, `lru` 24,
