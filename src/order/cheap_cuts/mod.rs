@@ -82,22 +82,22 @@
 //! there before step 6 (still 2–9% below meshopt-overdraw), 3.1–3.6% on the tuning models at
 //! the end, and holding it within 2% with `far` cost the overdraw that beats meshopt-overdraw.
 //! **Retuning for Intel's FIFO** (2026-12-06, `572fa2d`): pricing the cuts in that FIFO itself,
-//! `cache=128`, had not been tried. On the five tuning models, with the estimated graph, a grid
-//! of `cache` 128 or 192 × `budget` 0.015, 0.02, 0.025 or 0.03 × `lru` 20, 24 or 28 × `min` 48,
-//! 64 or 96 was measured, and the setting with the largest smallest margin to all five targets
-//! (in points of each target, against the best of cheap-cuts' peers) taken: `cache` 128,
-//! `budget` 0.02, `lru` 24, `min` 48, whose smallest margin is 0.32 points (OVR on bun_zipper; the four targets other
+//! `cache=128`, had not been tried. On the five tuning models, with the estimated graph, a grid of
+//! `cache` 128 or 192 × `budget` 0.015, 0.02, 0.025 or 0.03 × `lru` 20, 24 or 28 × `min` 48, 64 or
+//! 96 was measured, and the setting with the largest smallest margin to all five targets (in points
+//! of each target, against the best of cheap-cuts' peers) taken: `cache` 128, `budget` 0.02, `lru`
+//! 24, `min` 48, whose smallest margin is 0.32 points (OVR on bun_zipper; the four targets other
 //! than Intel had had 0.62, and Intel −1.55 on rocker-arm). Held out, measured after the choice:
 //! Intel within 2% on 15 of the 18 welded meshes instead of 1 (missed on dragon_vrip_res4, 2.0%
-//! above the best, Xbot 2.2%, CesiumMan 3.2%), but the main targets missed on six instead of
-//! two: OVR on armadillo (1.0484 against 1.0476), bunny_2k and dragon_vrip_res4, FIFO-16 on
-//! Michelle (1.5% above meshopt-vcache), and Fox and RiggedFigure as before. The overdraw margin
-//! the tuning models keep is half what it was, and held out it did not always hold. Tried after
-//! the choice and dropped, judged on the tuning models alone: each run's redraw judged in FIFO-16
-//! too (smallest margin 0.32 again, a tie); with both FIFOs costed (`cache=16` and `far`), a cut
-//! priced by the share of each one's budget it uses (0.26 at best over 36 settings); runs moved
-//! beside the run they share the most vertices with, at no more backward weight (Intel moved by
-//! 0.0003 at most: a FIFO of 128 keeps too little of a run to reuse its border).
+//! above the best, Xbot 2.2%, CesiumMan 3.2%), but the main targets missed on six instead of two:
+//! OVR on armadillo (1.0484 against 1.0476), bunny_2k and dragon_vrip_res4, FIFO-16 on Michelle
+//! (1.5% above meshopt-vcache), and Fox and RiggedFigure as before. The overdraw margin the tuning
+//! models keep is half what it was, and held out it did not always hold. Tried after the choice and
+//! dropped, judged on the tuning models alone: each run's redraw judged in FIFO-16 too (smallest
+//! margin 0.32 again, a tie); with both FIFOs costed (`cache=16` and `far`), a cut priced by the
+//! share of each one's budget it uses (0.26 at best over 36 settings); runs moved beside the run
+//! they share the most vertices with, at no more backward weight (Intel moved by 0.0003 at most: a
+//! FIFO of 128 keeps too little of a run to reuse its border).
 //! `experiments/cheap-cuts-intel-tradeoff.toml` draws both pricings' trade-offs, and
 //! `experiments/cheap-cuts-front.toml` the sweeps on the held-out misses.
 //!
