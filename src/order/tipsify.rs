@@ -148,7 +148,7 @@ impl Fans<'_> {
             count += 1;
             // The two corners other than the fan, in triangle order. Always two, so `top` advances
             // by a constant and the next scan's bounds and these stores' addresses do not wait on
-            // the corner tests (faster than pushing a variable count; README.md, Performance, has
+            // the corner tests (faster than pushing a variable count; docs/performance.md has
             // the measurement). A degenerate triangle may push the fan vertex itself, or one corner twice:
             // the fan vertex is dead whenever the stack is read, and a repeat wins no tie it would
             // not have won alone, so the order is the same.
@@ -201,7 +201,7 @@ fn next_neighbour(candidates: &[u32], vertices: &[Vertex], now: u32, cache: u32)
             // vertex comes from branch prediction and the CPU can start on its fan before this
             // scan is done; with a conditional move each fan waits for the previous scan's last
             // candidate. That pays where the predictor learns the branches (a small mesh ordered
-            // repeatedly) and costs little where it does not (README.md, Performance).
+            // repeatedly) and costs little where it does not (docs/performance.md).
             std::hint::cold_path();
             best = v;
             best_priority = priority;
