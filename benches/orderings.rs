@@ -6,7 +6,9 @@
 //! adjacency built once per mesh; `triorder bench --only orderings` also times them with that
 //! adjacency built inside, and prints ratios.
 //!
-//! Uses the shared bunny (69,451 triangles) when ../shared/data exists, else a procedural sphere.
+//! Uses the shared bunny (69,451 triangles) and the smallest shared mesh, RiggedSimple (188
+//! triangles, where forsyth is slowest against its peer: docs/performance.md), when
+//! ../shared/data exists, else procedural spheres of about those sizes.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -15,14 +17,19 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use triorder::mesh::{Scene, Source, source};
 use triorder::order;
 
-fn scene() -> Scene {
+/// The shared mesh `name`, or the procedural `fallback` without the shared data.
+fn scene(name: &str, fallback: &str) -> Scene {
     let data = source::data_dir(None).or_else(|| Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")));
     let open = |name: &str| Source::parse(name)?.open(data.as_deref(), 0);
-    open("models/bun_zipper.ply").or_else(|_| open("sphere:70000")).expect("a benchmark mesh")
+    open(name).or_else(|_| open(fallback)).expect("a benchmark mesh")
 }
 
 fn benches(c: &mut Criterion) {
-    let scene = scene();
+    bench_mesh(c, &scene("models/bun_zipper.ply", "sphere:70000"));
+    bench_mesh(c, &scene("animated/RiggedSimple.glb", "sphere:200"));
+}
+
+fn bench_mesh(c: &mut Criterion, scene: &Scene) {
     let (indices, n) = (scene.mesh.index_buffer(), scene.mesh.vertex_count());
     let mut group = c.benchmark_group(format!("orderings, {} triangles", scene.mesh.triangle_count()));
     group.sample_size(20);
@@ -33,7 +40,7 @@ fn benches(c: &mut Criterion) {
         ("cheap-cuts", "meshopt optimizeVertexCache + optimizeOverdraw(1.05)"),
     ] {
         let method = order::resolve(ours, 0).expect("a registered method");
-        group.bench_function(format!("triorder {ours}"), |b| b.iter(|| method.ordering.order(black_box(&scene))));
+        group.bench_function(format!("triorder {ours}"), |b| b.iter(|| method.ordering.order(black_box(scene))));
         group.bench_function(theirs, |b| {
             b.iter(|| match ours {
                 "forsyth" => meshopt::optimize_vertex_cache(black_box(&indices), n),
