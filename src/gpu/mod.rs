@@ -52,8 +52,9 @@ const MAX_SOFTWARE_DEVICES: usize = 8;
 /// The devices to split independent draws over: the shared one and, on a software adapter, one
 /// more per core (at most [`MAX_SOFTWARE_DEVICES`] in all). Mesa's lavapipe fetches, shades, clips
 /// and sets up every triangle of a device's queue on one thread, so one device keeps the other
-/// cores waiting for vertex work (docs/performance.md has the timings). Each extra device comes from its own instance, because
-/// lavapipe's devices on one instance share one set of rasterizer threads and take turns on it.
+/// cores waiting for vertex work (docs/performance.md has the timings). Each extra device comes
+/// from its own instance, because lavapipe's devices on one instance share one set of rasterizer
+/// threads and take turns on it.
 /// A hardware GPU gets its one device: it parallelises itself.
 pub fn pool() -> Result<Vec<&'static Gpu>> {
     static MORE: OnceLock<std::result::Result<Vec<Gpu>, String>> = OnceLock::new();
