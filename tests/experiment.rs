@@ -141,6 +141,11 @@ modles = ["a"]"#,
         (r#"metric = "acmr""#, r#"metric = ["acmr", "atvr"]"#, &["several metrics", "\"metric\""]),
         (r#"x = "cache_size""#, r#"x = "param:nope""#, &["figure.x", "no method of this spec has a parameter `nope`"]),
         (r#"x = "cache_size""#, r#"x = "metric:atvr""#, &["figure.x", "metric:atvr"]),
+        (
+            "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"",
+            "kind = \"scatter\"\nmetric = \"acmr\"\nx = \"metric:acmr@cahce=lru:16\"",
+            &["figure.x", "`cahce` is not a CSV column"],
+        ),
         (r#"kind = "line""#, "kind = \"bar\"\nx_log = true", &["figure.x_log", "bar"]),
         (r#"kind = "line""#, "kind = \"ratio\"", &["figure.ratio = [A, B]"]),
         (r#"kind = "line""#, "kind = \"ratio\"\nratio = [\"input\", \"nope\"]", &["figure.ratio names `nope`"]),
@@ -339,6 +344,12 @@ fn every_figure_kind_draws_from_one_csv() {
             "ATVR (misses per referenced vertex)",
         ),
         ("versus", "kind = \"scatter\"\nmetric = \"ovr_mean\"\nx = \"metric:ovr_max\"", "random seed=2"),
+        // One metric under two cache models, against each other.
+        (
+            "caches",
+            "kind = \"scatter\"\nmetric = \"acmr\"\nx = \"metric:acmr@cache=lru:16\"\nfacet = \"model\"\nfilter = { cache = \"fifo:8\" }",
+            "random seed=2",
+        ),
     ];
     for (id, figure, want) in kinds {
         let text = TINY.replace("id = \"tiny\"", &format!("id = \"{id}\"")).replace(
@@ -375,6 +386,15 @@ fn plotting_without_results_or_with_unusable_results_says_why() {
     run(&path, &quick(root.path())).unwrap();
     let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
     assert!(err.contains("a second `acmr` row") && err.contains("figure.filter"), "{err}");
+    // A metric on x that has a row per cache model must name the one it means.
+    let versus = TINY.replace(
+        "kind = \"line\"\nmetric = \"acmr\"\nx = \"cache_size\"\nfacet = \"model\"\nfilter = { cache_kind = \"fifo\" }",
+        "kind = \"scatter\"\nmetric = \"acmr\"\nx = \"metric:acmr\"\nfacet = \"model\"\nfilter = { cache = \"fifo:8\" }",
+    );
+    std::fs::write(&path, versus).unwrap();
+    run(&path, &quick(root.path())).unwrap();
+    let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
+    assert!(err.contains("several `acmr` values") && err.contains("metric:acmr@COLUMN=VALUE"), "{err}");
 }
 
 #[test]

@@ -66,7 +66,8 @@
 //!                                  # parameter, "param:clusters", or a key of an animated
 //!                                  # model, "source:subdiv" (clip, frames, subdiv); a scatter's x
 //!                                  # may name another metric of the same model and method,
-//!                                  # "metric:acmr"
+//!                                  # "metric:acmr" (with a row per cache model,
+//!                                  # "metric:acmr@cache=nvidia": the row named)
 //! series = "method"                # optional (default method): one colour per value
 //! facet = "model"                  # optional: one small chart per value, all in one SVG;
 //!                                  # series and facet may join columns, "model+method"

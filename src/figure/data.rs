@@ -38,6 +38,22 @@ pub struct Series {
     pub ranges: Vec<Option<(f64, f64)>>,
 }
 
+/// `METRIC[@COLUMN=VALUE…]`, as a scatter's x (`metric:acmr@cache=nvidia`), a gallery table's
+/// cells and a verdict table's checks name a metric: the metric, and the columns its rows must
+/// have where one model and method has several (one per cache model, say).
+pub(super) fn metric_where(text: &str) -> std::result::Result<(String, Vec<(String, String)>), String> {
+    let mut parts = text.split('@');
+    let metric = parts.next().unwrap_or_default().to_string();
+    let conditions = parts
+        .map(|c| {
+            c.split_once('=')
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .ok_or_else(|| format!("`{text}`: the condition `{c}` is not COLUMN=VALUE"))
+        })
+        .collect::<std::result::Result<_, _>>()?;
+    Ok((metric, conditions))
+}
+
 /// The value of `key` in the animated model `model` (a `model` cell of a results CSV), defaults
 /// written out; see [`Source::key`].
 pub fn source_key(model: &str, key: &str) -> Option<String> {
@@ -135,7 +151,8 @@ impl Table {
     /// Where a figure reads a column `name`: a CSV column; `param:NAME`, a parameter of the method
     /// (read from its canonical spec); `source:KEY`, a key of the animated model; or, for x and
     /// bar labels only, `metric:NAME`, the value of that metric for the same model and method (so
-    /// one metric can be plotted against, or written on, another); `A+B`, several of them joined
+    /// one metric can be plotted against, or written on, another; `metric:NAME@COLUMN=VALUE` where
+    /// it has several rows, `metric:acmr@cache=nvidia`); `A+B`, several of them joined
     /// (series or panels by, say, model and method at once).
     fn resolve(&self, name: &str) -> Result<Column> {
         if name.contains('+') {
@@ -147,20 +164,25 @@ impl Table {
         if let Some(key) = name.strip_prefix("source:") {
             return Ok(Column::Source(self.column("model")?, key.to_string()));
         }
-        let Some(metric) = name.strip_prefix("metric:") else {
+        let Some(wanted) = name.strip_prefix("metric:") else {
             return Ok(Column::Plain(self.column(name)?));
         };
+        let (metric, conditions) = metric_where(wanted).map_err(|e| Error::input(self.path.display(), e))?;
+        let conditions =
+            conditions.iter().map(|(c, v)| Ok((self.column(c)?, v.as_str()))).collect::<Result<Vec<_>>>()?;
         let (metric_col, value, model, method) =
             (self.column("metric")?, self.column("value")?, self.column("model")?, self.column("method")?);
         let mut values: Vec<((String, String), String)> = Vec::new();
-        for record in self.records.iter().filter(|r| &r[metric_col] == metric) {
+        for record in
+            self.records.iter().filter(|r| r[metric_col] == metric && conditions.iter().all(|&(c, v)| &r[c] == v))
+        {
             let key = (record[model].to_string(), record[method].to_string());
             match values.iter().find(|(k, _)| *k == key) {
                 Some((_, v)) if v != &record[value] => {
                     return Err(Error::input(
                         self.path.display(),
                         format!(
-                            "has several `{metric}` values for model {} and method {}, so x = \"{name}\" is ambiguous",
+                            "has several `{metric}` values for model {} and method {}, so x = \"{name}\" is ambiguous (name the rows: metric:{metric}@COLUMN=VALUE)",
                             key.0, key.1
                         ),
                     ));

@@ -41,7 +41,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::data::{Table, display_names};
+use super::data::{Table, display_names, metric_where};
 use super::verdicts::Verdicts;
 use crate::error::{Error, Result};
 
@@ -125,16 +125,7 @@ impl Recipe {
                 "cols" => recipe.cols = value.to_string(),
                 "cells" => {
                     for cell in value.split('/') {
-                        let mut parts = cell.split('@');
-                        let metric = parts.next().unwrap_or_default().to_string();
-                        let conditions = parts
-                            .map(|c| {
-                                c.split_once('=')
-                                    .map(|(k, v)| (k.to_string(), v.to_string()))
-                                    .ok_or_else(|| format!("cell condition `{c}` is not COLUMN=VALUE"))
-                            })
-                            .collect::<std::result::Result<_, _>>()?;
-                        recipe.cells.push((metric, conditions));
+                        recipe.cells.push(metric_where(cell)?);
                     }
                 }
                 "filter" => {

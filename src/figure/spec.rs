@@ -209,7 +209,7 @@ impl RawFigure {
         }
         // A CSV column; `param:NAME`, a parameter of the spec's methods; `source:KEY`, a key of its
         // animated models; or, where `metric_ok`, `metric:NAME`, another metric joined on model
-        // and method.
+        // and method (`metric:NAME@COLUMN=VALUE` where that has several rows).
         let column = |key: &str, name: &str, metric_ok: bool| {
             if let Some(source_key) = name.strip_prefix("source:") {
                 if !source::KEYS.contains(&source_key) {
@@ -230,6 +230,10 @@ impl RawFigure {
                 return Err(format!("{key} `{name}`: no method of this spec has a parameter `{param}`"));
             }
             if let Some(other) = name.strip_prefix("metric:").filter(|_| metric_ok) {
+                let (other, conditions) = data::metric_where(other).map_err(|e| format!("{key}: {e}"))?;
+                if let Some((column, _)) = conditions.iter().find(|(c, _)| !COLUMNS.contains(&c.as_str())) {
+                    return Err(format!("{key} `{name}`: `{column}` is not a CSV column"));
+                }
                 if measure::names().any(|m| m.name == other) {
                     return Ok(());
                 }

@@ -14,15 +14,16 @@
 //!   subject's value at most the reference's, plus P percent or times F. REFERENCE is a
 //!   `method_name` run in one variant only, a full `method` spec (`meshopt-overdraw:threshold=1.05`:
 //!   one variant of a sweep), or `best`: the lowest value of any ordering but `input` for that
-//!   model (and conditions) in the `best_from` CSV where it has the model, else in this one.
-//! - `best_from` (optional): the CSV `best` is read from first (a spec that runs every ordering).
+//!   model (and conditions) in the first `best_from` CSV that has the model, else in this one.
+//! - `best_from` (optional): the CSVs `best` is read from first, `|`-separated (a spec that runs
+//!   every ordering; then, for a table of one method's sweep, the table whose targets it shares).
 //! - `tuned` (optional): the model files a method's defaults were tuned on, `|`-separated; adds a
 //!   `set` column (tuned or held out) and lists the tuned models first.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::data::{Table, display_names, thousands};
+use super::data::{Table, display_names, metric_where, thousands};
 use crate::error::{Error, Result};
 
 /// One verdict table's recipe.
@@ -31,7 +32,7 @@ pub(super) struct Verdicts {
     pub(super) csv: String,
     subject: String,
     checks: Vec<Check>,
-    best_from: Option<String>,
+    best_from: Vec<String>,
     tuned: Option<Vec<String>>,
 }
 
@@ -72,7 +73,7 @@ impl Verdicts {
             csv: csv.trim().to_string(),
             subject: String::new(),
             checks: Vec::new(),
-            best_from: None,
+            best_from: Vec::new(),
             tuned: None,
         };
         for option in options.split_whitespace() {
@@ -82,7 +83,7 @@ impl Verdicts {
                 "checks" => {
                     recipe.checks = value.split('/').map(Check::parse).collect::<std::result::Result<_, _>>()?
                 }
-                "best_from" => recipe.best_from = Some(value.to_string()),
+                "best_from" => recipe.best_from = value.split('|').map(str::to_string).collect(),
                 "tuned" => recipe.tuned = Some(value.split('|').map(str::to_string).collect()),
                 _ => {
                     return Err(format!(
@@ -100,7 +101,7 @@ impl Verdicts {
     /// The markdown table, from the CSVs under `root`.
     pub(super) fn table(&self, root: &Path) -> Result<String> {
         let table = Table::read(&root.join(&self.csv))?;
-        let best_from = self.best_from.as_ref().map(|csv| Table::read(&root.join(csv))).transpose()?;
+        let best_from = self.best_from.iter().map(|csv| Table::read(&root.join(csv))).collect::<Result<Vec<_>>>()?;
         let path = table.path().display().to_string();
         let file = |model: &str| model.rsplit('/').next().unwrap_or(model).to_string();
         let is_tuned = |model: &str| self.tuned.as_ref().is_some_and(|t| t.contains(&file(model)));
@@ -146,7 +147,7 @@ impl Verdicts {
                 }
                 let mut cells = Vec::new();
                 for check in &self.checks {
-                    cells.push(check.verdict(&table, best_from.as_ref(), spec, model)?);
+                    cells.push(check.verdict(&table, &best_from, spec, model)?);
                 }
                 let variant = if several { format!(" {name} |") } else { String::new() };
                 let _ = writeln!(
@@ -166,11 +167,7 @@ impl Check {
     fn parse(text: &str) -> std::result::Result<Check, String> {
         let bad = || format!("check `{text}`: expected METRIC[@COLUMN=VALUE]<=REFERENCE[+P%|*F]");
         let (left, right) = text.split_once("<=").ok_or_else(bad)?;
-        let mut parts = left.split('@');
-        let metric = parts.next().unwrap_or_default().to_string();
-        let conditions = parts
-            .map(|c| c.split_once('=').map(|(k, v)| (k.to_string(), v.to_string())).ok_or_else(bad))
-            .collect::<std::result::Result<_, _>>()?;
+        let (metric, conditions) = metric_where(left).map_err(|_| bad())?;
         let number = |s: &str| s.parse::<f64>().ok().filter(|v| v.is_finite() && *v >= 0.0).ok_or_else(bad);
         let (reference, slack) = if let Some((reference, percent)) = right.split_once('+') {
             (reference, Slack::Percent(number(percent.strip_suffix('%').ok_or_else(bad)?)?))
@@ -216,7 +213,7 @@ impl Check {
 
     /// "yes" or "**no**", with the value of `subject` (a full method spec) against the
     /// reference's.
-    fn verdict(&self, table: &Table, best_from: Option<&Table>, subject: &str, model: &str) -> Result<String> {
+    fn verdict(&self, table: &Table, best_from: &[Table], subject: &str, model: &str) -> Result<String> {
         let here = self.values(table, model)?;
         let path = table.path().display().to_string();
         let missing = |what: &str| Error::input(&path, format!("no `{}` row of {what} on {model}", self.title()));
@@ -245,11 +242,14 @@ impl Check {
                 }
             }
             Against::Best => {
-                let everywhere = match best_from {
-                    Some(other) => self.values(other, model)?,
-                    None => Vec::new(),
-                };
-                let pool = if everywhere.is_empty() { here } else { everywhere };
+                let mut pool = here;
+                for other in best_from {
+                    let values = self.values(other, model)?;
+                    if !values.is_empty() {
+                        pool = values;
+                        break;
+                    }
+                }
                 pool.into_iter()
                     .filter(|(name, _, _)| name != "input")
                     .map(|(name, _, value)| (name, value))
@@ -314,6 +314,21 @@ models/b.ply,2000,peer,peer,seconds,,0.1
         let table = recipe.table(dir.path()).unwrap();
         assert!(table.contains("| a.ply (100) | yes (+1.4% vs wide) |"), "{table}");
         assert!(table.contains("| b.ply (2,000) | **no** (+14.3% vs peer) |"), "{table}");
+        // Several CSVs: the first that has the model, here the second for b.ply.
+        std::fs::write(
+            dir.path().join("peers.csv"),
+            "model,model_triangles,method_name,method,metric,cache,value
+models/a.ply,100,far,far,acmr,fifo:16,0.10
+models/b.ply,2000,near,near,acmr,fifo:16,0.79
+",
+        )
+        .unwrap();
+        let recipe =
+            Verdicts::parse("x.csv: subject=ours checks=acmr@cache=fifo:16<=best+2% best_from=all.csv|peers.csv")
+                .unwrap();
+        let table = recipe.table(dir.path()).unwrap();
+        assert!(table.contains("| a.ply (100) | yes (+1.4% vs wide) |"), "{table}");
+        assert!(table.contains("| b.ply (2,000) | yes (+1.3% vs near) |"), "{table}");
     }
 
     /// A swept subject gets a row per variant, named by the parameter that differs; a swept
