@@ -395,6 +395,12 @@ fn plotting_without_results_or_with_unusable_results_says_why() {
     run(&path, &quick(root.path())).unwrap();
     let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
     assert!(err.contains("several `acmr` values") && err.contains("metric:acmr@COLUMN=VALUE"), "{err}");
+    // Rows named that are not there are said to be missing, not drawn as an empty chart.
+    let absent =
+        std::fs::read_to_string(&path).unwrap().replace("x = \"metric:acmr\"", "x = \"metric:acmr@cache=lru:99\"");
+    std::fs::write(&path, absent).unwrap();
+    let err = plot(&path, &plot_quick(root.path())).unwrap_err().to_string();
+    assert!(err.contains("has no `acmr` rows at cache = lru:99"), "{err}");
 }
 
 #[test]

@@ -191,6 +191,10 @@ impl Table {
                 None => values.push((key, record[value].to_string())),
             }
         }
+        if values.is_empty() {
+            let at: String = conditions.iter().map(|&(c, v)| format!(" at {} = {v}", &self.header[c])).collect();
+            return Err(Error::input(self.path.display(), format!("has no `{metric}` rows{at} for x = \"{name}\"")));
+        }
         Ok(Column::Metric { model, method, values })
     }
 
