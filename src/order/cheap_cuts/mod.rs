@@ -101,11 +101,11 @@
 //! `experiments/cheap-cuts-intel-tradeoff.toml` draws both pricings' trade-offs, and
 //! `experiments/cheap-cuts-front.toml` the sweeps on the held-out misses.
 //! `experiments/cheap-cuts-vendor-tradeoff.toml` sweeps `lru` from 16 to 40, beside Forsyth's
-//! own order at each LRU: on the scans a longer LRU lowers Intel's ACMR and raises NVIDIA's along
-//! a front (at 32 NVIDIA's target fails on six of eleven), while on the seamed characters both
-//! orders' Intel ACMR scatters by up to 3% between neighbouring LRUs, and 24 happens to be a high
-//! draw on CesiumMan and Xbot, the held-out Intel misses (Intel's target is met on both at 28 and
-//! 32). On the tuning models only 24 meets every target, so it stays; a finer look there, `lru`
+//! own order at each LRU: on the scans of 20,000 triangles and more a longer LRU lowers Intel's
+//! ACMR and raises NVIDIA's along a front (at 32 NVIDIA's target fails on six of the eleven
+//! scans), while on smaller meshes and Xbot both orders' Intel ACMR scatters by up to 3% between
+//! neighbouring LRUs, and 24 happens to be a high draw on CesiumMan and Xbot, the held-out Intel
+//! misses (Intel's target is met on both at 28 and 32). On the tuning models only 24 meets every target, so it stays; a finer look there, `lru`
 //! 22 or 26 at budgets 0.015–0.025 (scratch `triorder eval` runs, five settings), left smallest
 //! margins of −0.41 to 0.18 points against the defaults' 0.32.
 //!
