@@ -704,42 +704,35 @@ fn draw<const DEPTH_TEST: bool, S: FragmentSink>(
             if DEPTH_TEST && S::COUNTS_ONLY && wide {
                 let (from, to) = run(&mut runs);
                 depth_test_run(&mut depth[row..], from, to, plane, &mut counts);
-                for e in &mut edges {
-                    e.row += e.step_y;
-                }
-                continue;
-            }
-            let mut fragment = |x: i64| {
-                let z = plane.at(x);
-                let mut passed = false;
-                if DEPTH_TEST {
-                    let d = &mut depth[row + x as usize];
-                    passed = z < *d;
-                    if passed {
-                        counts.covered += u64::from(*d == 1.0);
-                        *d = z;
-                        counts.passed += 1;
-                    }
-                }
-                on_fragment.fragment(Fragment {
-                    pixel: (row + x as usize) as u32,
-                    triangle: t as u32,
-                    depth: z,
-                    passed,
-                });
-            };
-            if wide {
-                let (from, to) = run(&mut runs);
-                (from..=to).for_each(&mut fragment);
             } else {
-                let (mut e0, mut e1, mut e2) = (edges[0].row, edges[1].row, edges[2].row);
-                for x in x0..=x1 {
-                    if (e0 | e1 | e2) >= 0 {
-                        fragment(x);
+                let mut fragment = |x: i64| {
+                    let z = plane.at(x);
+                    let mut passed = false;
+                    if DEPTH_TEST {
+                        let d = &mut depth[row + x as usize];
+                        passed = z < *d;
+                        if passed {
+                            counts.covered += u64::from(*d == 1.0);
+                            *d = z;
+                            counts.passed += 1;
+                        }
                     }
-                    e0 += edges[0].step_x;
-                    e1 += edges[1].step_x;
-                    e2 += edges[2].step_x;
+                    let pixel = (row + x as usize) as u32;
+                    on_fragment.fragment(Fragment { pixel, triangle: t as u32, depth: z, passed });
+                };
+                if wide {
+                    let (from, to) = run(&mut runs);
+                    (from..=to).for_each(&mut fragment);
+                } else {
+                    let (mut e0, mut e1, mut e2) = (edges[0].row, edges[1].row, edges[2].row);
+                    for x in x0..=x1 {
+                        if (e0 | e1 | e2) >= 0 {
+                            fragment(x);
+                        }
+                        e0 += edges[0].step_x;
+                        e1 += edges[1].step_x;
+                        e2 += edges[2].step_x;
+                    }
                 }
             }
             for e in &mut edges {
