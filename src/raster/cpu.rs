@@ -625,13 +625,21 @@ fn depth_test_run(row: &mut [f32], from: i64, to: i64, plane: Plane, counts: &mu
 #[cfg(not(target_arch = "x86_64"))]
 fn depth_test_run(row: &mut [f32], from: i64, to: i64, plane: Plane, counts: &mut ViewCounts) {
     for x in from..=to {
-        let (z, d) = (plane.at(x), &mut row[x as usize]);
-        if z < *d {
-            counts.covered += u64::from(*d == 1.0);
-            *d = z;
-            counts.passed += 1;
-        }
+        depth_test(&mut row[x as usize], plane.at(x), counts);
     }
+}
+
+/// One fragment at depth `z` tested (LESS) against the stored depth `d` and counted: whether it
+/// passed. A pixel is covered when its first fragment passes (the cleared depth is 1.0).
+#[inline(always)]
+fn depth_test(d: &mut f32, z: f32, counts: &mut ViewCounts) -> bool {
+    let passed = z < *d;
+    if passed {
+        counts.covered += u64::from(*d == 1.0);
+        *d = z;
+        counts.passed += 1;
+    }
+    passed
 }
 
 /// Draws `triangles` in order into a cleared depth buffer and counts; `on_fragment` sees every
@@ -707,16 +715,7 @@ fn draw<const DEPTH_TEST: bool, S: FragmentSink>(
             } else {
                 let mut fragment = |x: i64| {
                     let z = plane.at(x);
-                    let mut passed = false;
-                    if DEPTH_TEST {
-                        let d = &mut depth[row + x as usize];
-                        passed = z < *d;
-                        if passed {
-                            counts.covered += u64::from(*d == 1.0);
-                            *d = z;
-                            counts.passed += 1;
-                        }
-                    }
+                    let passed = DEPTH_TEST && depth_test(&mut depth[row + x as usize], z, &mut counts);
                     let pixel = (row + x as usize) as u32;
                     on_fragment.fragment(Fragment { pixel, triangle: t as u32, depth: z, passed });
                 };
