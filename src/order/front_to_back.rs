@@ -12,9 +12,10 @@
 //! change their order): that rounding would break exact ties, and real meshes have them (two
 //! triangles of `spot` whose corner heights sum to the same six-decimal value in the file).
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
-use super::{Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::key_sort::by_increasing;
+use super::{Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::Framing;
 use crate::mesh::Scene;
@@ -53,19 +54,26 @@ impl Ordering for FrontToBack {
             Error::usage("method `front-to-back`: the view direction x, y, z must not be zero".to_string())
         })?;
         let mesh = &scene.mesh;
-        let (direction, center) = (direction.as_dvec3(), Framing::of(&mesh.positions).center);
-        let vertex_depth: Vec<f64> = mesh.positions.iter().map(|p| (p.as_dvec3() - center).dot(direction)).collect();
-        let depth: Vec<f64> = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let mut d = t.map(|v| vertex_depth[v as usize]);
-                d.sort_by(f64::total_cmp);
-                d.iter().sum()
-            })
-            .collect();
-        let mut order: Order = (0..mesh.triangle_count() as u32).collect();
-        order.sort_by(|&a, &b| depth[b as usize].total_cmp(&depth[a as usize]));
+        let center = Framing::of(&mesh.positions).center;
+        let depth = centroid_depths(&mesh.positions, center, direction.as_dvec3(), &mesh.triangles);
+        // Nearest first: by decreasing depth, which negation turns into increasing exactly.
+        let nearness: Vec<f64> = depth.iter().map(|d| -d).collect();
+        let order = by_increasing(&nearness);
         Ok(Orders::from(order))
     }
+}
+
+/// Each triangle's depth along `direction` (unit length) from `center`, three times its
+/// centroid's: its corner depths in f64, summed in increasing order so that the sum does not
+/// depend on which corner the triangle lists first.
+pub(crate) fn centroid_depths(positions: &[Vec3], center: DVec3, direction: DVec3, triangles: &[[u32; 3]]) -> Vec<f64> {
+    let vertex_depth: Vec<f64> = positions.iter().map(|p| (p.as_dvec3() - center).dot(direction)).collect();
+    triangles
+        .iter()
+        .map(|t| {
+            let mut d = t.map(|v| vertex_depth[v as usize]);
+            d.sort_by(f64::total_cmp);
+            d.iter().sum()
+        })
+        .collect()
 }

@@ -51,6 +51,7 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
+use super::key_sort::sort_by_key;
 use super::sander07::{LAMBDA, patches};
 use super::tipsify::FIFO_CACHE;
 use super::{Clustered, Lookup, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
@@ -406,18 +407,6 @@ impl Hs17 {
     }
 }
 
-/// The indices of `keyed` (key, payload) pairs sorted by increasing key ([`f64::total_cmp`]'s
-/// order), ties by index, each with its payload.
-///
-/// A radix sort (`radsort`: stable, so ties stay in index order, and it skips the bytes every key
-/// shares): step 2 sorts every patch once per changed cluster per round, and at λ 3 a patch is a
-/// triangle (786k on Xbot subdivided twice), where a comparison sort took a third of the run.
-fn sort_by_key(keyed: impl Iterator<Item = (f64, u32)>) -> Vec<(u32, u32)> {
-    let mut entries: Vec<(f64, u32, u32)> = keyed.zip(0..).map(|((k, payload), i)| (k, i, payload)).collect();
-    radsort::sort_by_key(&mut entries, |e| e.0);
-    entries.into_iter().map(|(_, i, payload)| (i, payload)).collect()
-}
-
 /// Per patch, per frame of `frames`: the mean of its triangles' corners, in the unit frame the
 /// cameras see the keyframes in (centred, divided by the animation's radius, in f64), so the
 /// distances to the viewpoints neither underflow nor overflow in f32 and do not depend on the
@@ -575,22 +564,5 @@ impl Clock {
             Some((_, s)) => *s += seconds,
             None => self.phases.push((phase, seconds)),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The integer keys order floats as `total_cmp` does, and the sort breaks ties by index.
-    #[test]
-    fn sorting_by_key_is_total_order_then_index() {
-        let keys = [3.5, -0.0, 0.0, -2.0, f64::INFINITY, 1e-300, -1e300, 3.5, f64::NAN, -f64::NAN, 0.0];
-        let mut expected: Vec<usize> = (0..keys.len()).collect();
-        expected.sort_by(|&a, &b| keys[a].total_cmp(&keys[b]).then(a.cmp(&b)));
-        let sorted = sort_by_key(keys.iter().map(|&k| (k, 0)).zip(100..).map(|((k, _), p)| (k, p)));
-        assert_eq!(sorted.iter().map(|&(i, _)| i as usize).collect::<Vec<_>>(), expected);
-        assert!(sorted.iter().all(|&(i, payload)| payload == 100 + i));
-        assert_eq!(&expected[..3], &[9, 6, 3]);
     }
 }

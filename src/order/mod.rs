@@ -7,10 +7,12 @@
 //! (well-formed and deterministic orders on every test mesh, what `order` writes, bad
 //! parameters) pick it up with no other change.
 //!
-//! The files here are the methods, except [`orders`] (what a method returns) and [`params`]
-//! (method specs); families that share helpers have a folder: `curves/` (snake, Hilbert),
-//! `meshopt/` (the peers), `mla/`, `nehab/` and `cheap_cuts/` (their helpers beside them).
+//! The files here are the methods, except [`orders`] (what a method returns), [`params`]
+//! (method specs) and [`key_sort`] (the radix sort by depth or distance that some share);
+//! families that share helpers have a folder: `curves/` (snake, Hilbert), `meshopt/` (the peers),
+//! `mla/`, `nehab/` and `cheap_cuts/` (their helpers beside them).
 
+pub mod key_sort;
 pub mod levels;
 pub mod orders;
 pub mod params;

@@ -7,10 +7,12 @@
 //! cross). Depths are the sums of the three corner depths in f64 from the frame's centre, as
 //! `front-to-back` takes them; ties keep the input order.
 
-use glam::DVec3;
+use rayon::prelude::*;
 
+use super::super::front_to_back::centroid_depths;
+use super::super::key_sort::by_increasing;
 use super::super::orders::Lookup;
-use super::super::{Clustered, Cost, Method, Order, Ordering, Orders, ParamInfo, ParamKind, Params};
+use super::super::{Clustered, Cost, Method, Ordering, Orders, ParamInfo, ParamKind, Params};
 use crate::error::{Error, Result};
 use crate::mesh::Scene;
 use crate::raster::views::icosphere_directions;
@@ -57,25 +59,15 @@ impl Ordering for PerView {
         for f in 0..frames.len() {
             // From the centre, not divided by the radius (which would not change the order, but
             // its rounding would break exact ties differently in a rescaled copy), as
-            // `front-to-back` takes them.
-            let center = frames.framing.center;
-            let unit: Vec<DVec3> = frames.frames[f].iter().map(|&p| p.as_dvec3() - center).collect();
+            // `front-to-back` takes them. Farthest from the eye (smallest projection on the
+            // direction to it) first. The viewpoints are sorted in parallel: each is a sort of
+            // every triangle, and they are independent.
             let triangles = frames.triangles(f, &scene.mesh);
-            for direction in &directions {
-                let d = direction.as_dvec3();
-                let depth: Vec<f64> = triangles
-                    .iter()
-                    .map(|t| {
-                        let mut z = t.map(|v| unit[v as usize].dot(d));
-                        z.sort_by(f64::total_cmp);
-                        z.iter().sum()
-                    })
-                    .collect();
-                let mut order: Order = (0..triangles.len() as u32).collect();
-                // Farthest from the eye (smallest projection on the direction to it) first.
-                order.sort_by(|&a, &b| depth[a as usize].total_cmp(&depth[b as usize]));
-                buffers.push(Clustered::single(order));
-            }
+            let positions = &frames.frames[f];
+            buffers.par_extend(directions.par_iter().map(|direction| {
+                let depth = centroid_depths(positions, frames.framing.center, direction.as_dvec3(), &triangles);
+                Clustered::single(by_increasing(&depth))
+            }));
         }
         let assignment: Vec<u16> = (0..count as u16).collect();
         Ok(Orders {
