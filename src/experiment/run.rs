@@ -23,6 +23,7 @@ use crate::error::{Error, Result};
 use crate::figure::spec::FigureKind;
 use crate::measure::{self, Evaluation, cache};
 use crate::mesh::progressive::Update;
+use crate::mesh::scene::SharedWork;
 use crate::mesh::{Mesh, Scene, source};
 use crate::order::{self, Clustered, Orders, Resolved};
 use crate::raster::kept::{KeptLayers, LayerMemo};
@@ -99,6 +100,11 @@ pub fn run(spec: &Path, opts: &RunOptions) -> Result<Outcome> {
 ///   CPU from the same view set at the same size. Six specs measure Soldier's keyframes from the
 ///   same 300 views, each with orders of its own; each view is rasterized once.
 ///
+/// - a scene's shared work ([`crate::mesh::scene::SharedWork`]): the same model opened the same
+///   way. hs17's rasterized (keyframe, viewpoint) nodes are named by frame, viewpoints and size,
+///   and six specs run hs17 on Soldier's 91 keyframes from the same 162 viewpoints (two from 642):
+///   each node is rasterized once instead of once a spec, and each reuse charged at what it cost.
+///
 /// `reproduce` runs every spec with one. Only what a later spec asks for is kept, each until the
 /// last spec that asks for it has run.
 #[derive(Default)]
@@ -107,6 +113,8 @@ pub struct RunMemo {
     kept: HashMap<String, Evaluation>,
     views: Claims,
     layers: LayerMemo,
+    scenes: Claims,
+    work: HashMap<String, SharedWork>,
 }
 
 /// Per key, the specs still to run that ask for it; only keys two or more specs ask for.
@@ -144,7 +152,7 @@ impl Claims {
 impl RunMemo {
     /// A memo for running `specs` in turn under `opts`.
     pub fn for_specs<'s>(specs: impl IntoIterator<Item = &'s Spec>, opts: &RunOptions) -> Result<RunMemo> {
-        let (mut orders, mut views) = (Vec::new(), Vec::new());
+        let (mut orders, mut views, mut scenes) = (Vec::new(), Vec::new(), Vec::new());
         for spec in specs {
             let plan = Plan::new(spec, opts)?;
             for u in 0..plan.units.len() {
@@ -152,9 +160,15 @@ impl RunMemo {
             }
             for m in 0..plan.models.len() {
                 views.extend(plan.view_key(spec, opts, m)?.map(|key| (key, spec.id.clone())));
+                scenes.push((plan.scene_key(spec, opts, m)?, spec.id.clone()));
             }
         }
-        Ok(RunMemo { orders: Claims::of(orders), views: Claims::of(views), ..RunMemo::default() })
+        Ok(RunMemo {
+            orders: Claims::of(orders),
+            views: Claims::of(views),
+            scenes: Claims::of(scenes),
+            ..RunMemo::default()
+        })
     }
 
     /// The evaluation for `key` asked for by `spec`: the one kept, or what `order` gives, kept
@@ -185,12 +199,27 @@ impl RunMemo {
         }
     }
 
+    /// The shared work an earlier spec kept for the scene `key` names (a [`Plan::scene_key`]), or
+    /// none yet.
+    fn scene_work(&mut self, key: &str) -> SharedWork {
+        self.work.remove(key).unwrap_or_default()
+    }
+
+    /// Keeps `work`, done on the scene `key` names, when a later spec opens that scene too.
+    fn keep_scene_work(&mut self, spec: &str, key: String, work: SharedWork) {
+        if self.scenes.by_another(&key, spec) {
+            self.work.insert(key, work);
+        }
+    }
+
     /// Forgets `spec`'s claims once it has run, dropping what no spec still to run asks for.
     fn finished(&mut self, spec: &str) {
         self.orders.finished(spec);
         self.views.finished(spec);
+        self.scenes.finished(spec);
         self.kept.retain(|key, _| self.orders.contains(key));
         self.layers.retain(|key| self.views.contains(key));
+        self.work.retain(|key, _| self.scenes.contains(key));
     }
 }
 
@@ -232,6 +261,19 @@ impl<'a> Plan<'a> {
             self.updates[unit.update],
             spec.measure_options(work).per_draw_call,
             self.methods[unit.method].canonical()
+        ))
+    }
+
+    /// What names model `m`'s scene ([`RunMemo`]): how it is opened. Its shared work is named by
+    /// what it depends on besides the scene.
+    fn scene_key(&self, spec: &Spec, opts: &RunOptions, m: usize) -> Result<String> {
+        let work = spec.workload(opts.quick)?;
+        Ok(format!(
+            "{:?} seed {} levels {:?} per draw call {}",
+            self.models[m].source,
+            spec.seed,
+            work.levels,
+            spec.measure_options(work).per_draw_call
         ))
     }
 
@@ -354,6 +396,8 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
             Err(e) => return Err(e),
         };
         let mut scene = scene;
+        let scene_key = plan.scene_key(spec, opts, m)?;
+        scene.shared = memo.scene_work(&scene_key);
         // The methods of one update are ordered one by one, then measured together, so that the
         // work every order shares (each view rasterized once for overdraw) is done once.
         let view_key = plan.view_key(spec, opts, m)?;
@@ -409,6 +453,7 @@ pub fn run_spec(spec: &Spec, opts: &RunOptions, bars: &MultiProgress, memo: &mut
         if let Some(key) = &view_key {
             memo.measured(&spec.id, key);
         }
+        memo.keep_scene_work(&spec.id, scene_key, std::mem::take(&mut scene.shared));
         if failures.len() > failed {
             bar.set_prefix(format!(
                 "{} ({} failed)",
@@ -624,6 +669,28 @@ mod tests {
         memo.finished("b");
         assert!(memo.kept.is_empty() && !memo.orders.contains("k"));
         assert_eq!(computed, 2);
+    }
+
+    /// A scene's shared work goes to the later spec that opens the same scene, with what computing
+    /// it cost, and to no other; once the last spec that opens it has run it is gone.
+    #[test]
+    fn a_memo_hands_a_scenes_work_to_the_later_specs_that_open_it() {
+        let claims = [("s", "a"), ("s", "b"), ("t", "a")].map(|(k, s)| (k.to_string(), s.to_string()));
+        let mut memo = RunMemo { scenes: Claims::of(claims), ..RunMemo::default() };
+        for (scene, value) in [("s", 7), ("t", 8)] {
+            let work = memo.scene_work(scene);
+            assert!(work.get_or_compute::<u32, ()>("nodes", || Ok(value)).unwrap().1.is_none());
+            memo.keep_scene_work("a", scene.to_string(), work);
+        }
+        assert_eq!(memo.work.len(), 1, "kept for the scene b opens only");
+        memo.finished("a");
+        let work = memo.scene_work("s");
+        let (value, reused) = work.get_or_compute::<u32, ()>("nodes", || panic!("computed again")).unwrap();
+        assert_eq!((*value, reused.is_some()), (7, true));
+        memo.keep_scene_work("b", "s".to_string(), work);
+        assert!(memo.work.is_empty(), "b is the last spec that opens it");
+        memo.finished("b");
+        assert!(memo.scene_work("s").get_or_compute::<u32, ()>("nodes", || Ok(9)).unwrap().1.is_none());
     }
 
     /// Views' layers are kept under a key while a later spec asks for it: the first spec's
