@@ -99,7 +99,6 @@ pub fn run(spec: &Path, opts: &RunOptions) -> Result<Outcome> {
 /// - views' depth layers ([`LayerMemo`]): the same model opened the same way, measured on the
 ///   CPU from the same view set at the same size. Six specs measure Soldier's keyframes from the
 ///   same 300 views, each with orders of its own; each view is rasterized once.
-///
 /// - a scene's shared work ([`crate::mesh::scene::SharedWork`]): the same model opened the same
 ///   way. hs17's rasterized (keyframe, viewpoint) nodes are named by frame, viewpoints and size,
 ///   and six specs run hs17 on Soldier's 91 keyframes from the same 162 viewpoints (two from 642):

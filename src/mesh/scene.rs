@@ -82,7 +82,8 @@ impl Scene {
 }
 
 /// Work derived from a scene that several orderings of it need, computed by the first that asks
-/// and kept for the others while the scene lives: `hs17` rasterizes the same (keyframe,
+/// and kept for the others while the scene lives (and by `reproduce` for the later specs that open
+/// the same scene, [`crate::experiment::run::RunMemo`]): `hs17` rasterizes the same (keyframe,
 /// viewpoint) nodes for every λ, mode, seed and cluster count, and a run orders all of a model's
 /// methods on one scene. Each entry keeps the wall time computing it took, which a later ordering
 /// that reuses it charges to its own time ([`crate::order::Orders::reused`]), so that an
