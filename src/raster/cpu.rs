@@ -24,7 +24,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::layers::{self, DepthLayers, LaneRanks};
+use super::layers::{self, DepthLayers, LaneRanks, Sorting};
 use super::views::Camera;
 use super::{OrderPicks, RasterBackend, ViewCounts};
 use crate::error::{Error, Result};
@@ -207,11 +207,11 @@ impl Local {
     }
 }
 
-/// One thread's buffers for [`DepthLayers`]: the fragments and the pixel slots.
+/// One thread's buffers for [`DepthLayers`]: the fragments and the scratch that sorts them.
 #[derive(Default)]
 struct LayerScratch {
     fragments: Vec<Fragment>,
-    slots: Vec<u32>,
+    sorting: Sorting,
 }
 
 impl LayerScratch {
@@ -223,7 +223,7 @@ impl LayerScratch {
         draw::<false, _>(screen, &local.triangles, res, &mut Vec::new(), |f: Fragment| {
             self.fragments.push(Fragment { triangle: ids[f.triangle as usize], ..f })
         });
-        DepthLayers::of(&self.fragments, res, &mut self.slots)
+        DepthLayers::of(&self.fragments, res, &mut self.sorting)
     }
 }
 
