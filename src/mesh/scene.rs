@@ -68,10 +68,11 @@ impl Scene {
     }
 
     /// The same levels with their sequence kept by `update` instead (no effect on other scenes).
+    /// The shared work stays: the levels' meshes do not change, only how an order is kept through
+    /// them, and the full mesh's order that both updates keep is made once.
     pub fn set_update(&mut self, update: Update) {
         if let Kind::Levels(levels) = &mut self.frames.kind {
             levels.update = update;
-            self.shared = SharedWork::default();
         }
     }
 
@@ -88,7 +89,9 @@ impl Scene {
 /// methods on one scene. Each entry keeps the wall time computing it took, which a later ordering
 /// that reuses it charges to its own time ([`crate::order::Orders::reused`]), so that an
 /// ordering's `seconds` stay what it costs on its own, whichever ran first. Entries are named
-/// by what they were computed from besides the scene; a scene whose frames change starts afresh.
+/// by what they were computed from besides the scene; a scene whose frames change starts afresh,
+/// but not one whose levels only change their update ([`Scene::set_update`]): an entry must not
+/// depend on it.
 #[derive(Default)]
 pub struct SharedWork {
     entries: Mutex<HashMap<String, Computed>>,
