@@ -611,9 +611,11 @@ impl<'a> State<'a> {
         // A new best is rare after the first few candidates (the front of the LRU lists its
         // triangles first), so it is marked cold: the compiler then branches around the update
         // instead of selecting, and the candidates no longer wait on one another through the
-        // running maximum. Ordering RiggedSimple went from 0.73-0.81x meshoptimizer's speed to
-        // 0.95-0.97x, RiggedFigure from 0.79-0.81x to 1.03-1.06x, the large meshes unchanged or
-        // faster (`triorder bench`, Intel Xeon, December 2026); the same orders.
+        // running maximum. Ordering RiggedSimple went from 0.74-0.81x meshoptimizer's speed to
+        // 0.97-1.18x, RiggedFigure from 0.81-0.82x to 1.04-1.16x; the larger meshes, where an
+        // update is less predictable, stayed at 1.20-1.69x, up to 16% below the select on some
+        // (Soldier, BrainStem) and above it on Xbot (`triorder bench`, three runs, Intel Xeon,
+        // December 2026; docs/performance.md). The same orders.
         let (mut best, mut best_score) = (NONE, f32::NEG_INFINITY);
         let mut consider = |t: u32| {
             let sum = triangle_score(triangles, score, t);

@@ -71,17 +71,16 @@ impl DepthLayers {
         for f in fragments.iter().filter(can_pass) {
             slots[f.pixel as usize - first + 1] += 1;
         }
-        // Pixel i's start, from a running sum in a register: summing in place, each slot would
-        // wait on the store of the one before (12% of building a view's layers). The same pass
-        // counts the pixels with one fragment and lists those with more, without a branch: a
-        // branch on each pixel's count (0, 1 or more, in no pattern) and the single count kept
-        // in memory were half of this function's time on RobotExpressive (perf).
         // Grown, never cleared: every entry read below is written first.
         if contested.len() <= span {
             contested.resize(span + 1, 0);
         }
-        // Slot i counts pixel i − 1 (slot 0 counts nothing), and a contested pixel is listed by
-        // its slot.
+        // Pixel i's start, from a running sum in a register: summing in place, each slot would
+        // wait on the store of the one before (12% of building a view's layers). The same pass
+        // counts the pixels with one fragment and lists those with more, without a branch: a
+        // branch on each pixel's count (0, 1 or more, in no pattern) and the single count kept
+        // in memory were half of this function's time on RobotExpressive (perf). Slot i counts
+        // pixel i − 1 (slot 0 counts nothing), and a contested pixel is listed by its slot.
         let (mut running, mut singles, mut listed) = (0, 0, 0);
         for (i, slot) in slots.iter_mut().enumerate() {
             let count = *slot;
